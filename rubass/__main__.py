@@ -1,0 +1,6 @@
+"""`python3 -m rubass …` runs the command line."""
+import sys
+
+from .cli import main
+
+sys.exit(main())

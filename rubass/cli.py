@@ -1,0 +1,122 @@
+"""The `rubass` command line: check, fmt, replay, experiments. Exit 0 ok, 1 errors, 2 usage."""
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+from typing import Callable, Dict, List, Optional, Sequence
+
+from .lang import SpecError, format_spec, load_spec, parse_source
+from .lang.errors import Diagnostic
+from .lang.source import SourceSet
+from .lang.sourcefile import read_source
+
+
+def _print_diags(diags: Sequence[Diagnostic], sources: Optional[SourceSet]) -> None:
+    for d in diags:
+        print(d.render(sources), file=sys.stderr)
+
+
+def cmd_check(args: argparse.Namespace) -> int:
+    """Check each spec; all errors of all files are printed."""
+    status = 0
+    for path in args.spec:
+        try:
+            checked = load_spec(path, args.actions)
+        except SpecError as exc:
+            print(exc.render(), file=sys.stderr)
+            n = sum(d.severity == "error" for d in exc.diagnostics)
+            print(f"{path}: {n} error{'s' if n != 1 else ''}", file=sys.stderr)
+            status = 1
+            continue
+        _print_diags(checked.warnings, checked.sources)
+        if not args.quiet:
+            print(f"{path}: ok ({len(checked.rules)} rules, {len(checked.behaviours)} behaviours, "
+                  f"{len(checked.topics)} topics, {len(checked.nodes)} nodes, {len(checked.actions)} actions)")
+    return status
+
+
+def cmd_fmt(args: argparse.Namespace) -> int:
+    """Print, check or rewrite the canonical layout of a spec."""
+    src, diag = read_source(args.spec)
+    if src is None:
+        assert diag is not None
+        _print_diags([diag], None)
+        return 1
+    try:
+        spec = parse_source(src)
+    except SpecError as exc:
+        print(exc.render(), file=sys.stderr)
+        return 1
+    text = format_spec(spec, src.text)
+    if args.check:
+        if text != src.text:
+            print(f"{args.spec}: not in canonical layout (run 'rubass fmt --write {args.spec}')", file=sys.stderr)
+            return 1
+        return 0
+    if args.write:
+        if text != src.text:
+            tmp = args.spec + ".rubass-fmt.tmp"
+            with open(tmp, "w", encoding="utf-8") as fh:
+                fh.write(text)
+            os.replace(tmp, args.spec)
+        return 0
+    sys.stdout.write(text)
+    return 0
+
+
+def _parser() -> argparse.ArgumentParser:
+    p = argparse.ArgumentParser(prog="rubass", description="RuBaSS safety specs: check, format, replay.")
+    sub = p.add_subparsers(dest="command", metavar="COMMAND")
+    c = sub.add_parser("check", help="check specs for errors")
+    c.add_argument("spec", nargs="+", metavar="SPEC")
+    c.add_argument("--actions", action="append", default=[], metavar="LIB.yaml",
+                   help="an action library to load besides the spec's imports (repeatable)")
+    c.add_argument("-q", "--quiet", action="store_true", help="print nothing when clean")
+    c.set_defaults(func=cmd_check)
+    f = sub.add_parser("fmt", help="print a spec in canonical layout")
+    f.add_argument("spec", metavar="SPEC")
+    g = f.add_mutually_exclusive_group()
+    g.add_argument("--check", action="store_true", help="exit 1 if the file is not in canonical layout")
+    g.add_argument("--write", action="store_true", help="rewrite the file in place")
+    f.set_defaults(func=cmd_fmt)
+    for name, register in _EXTRA_COMMANDS.items():
+        register(sub)
+    return p
+
+
+def _register_replay(sub: "argparse._SubParsersAction[argparse.ArgumentParser]") -> None:
+    try:
+        from .replay.command import register
+    except ImportError:  # the replay module comes with the engine
+        return
+    register(sub)
+
+
+def _register_experiments(sub: "argparse._SubParsersAction[argparse.ArgumentParser]") -> None:
+    try:
+        from .sim.experiments_command import register
+    except ImportError:
+        return
+    register(sub)
+
+
+_EXTRA_COMMANDS: Dict[str, Callable[..., None]] = {
+    "replay": _register_replay,
+    "experiments": _register_experiments,
+}
+
+
+def main(argv: Optional[List[str]] = None) -> int:
+    parser = _parser()
+    args = parser.parse_args(argv)
+    if not getattr(args, "func", None):
+        parser.print_usage(sys.stderr)
+        print("rubass: error: a command is required (check, fmt, ...)", file=sys.stderr)
+        return 2
+    try:
+        return int(args.func(args))
+    except KeyboardInterrupt:
+        return 130
+    except BrokenPipeError:
+        return 0

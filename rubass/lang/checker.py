@@ -1,0 +1,299 @@
+"""The checker (LANGUAGE.md §3, §9): names, duplicates, cycles, actions and libraries.
+
+Every problem in a spec is reported in one run; kinds and units are checked by typecheck.
+"""
+from __future__ import annotations
+
+import os
+from typing import Dict, FrozenSet, List, Optional, Sequence, Set, Tuple
+
+from . import ast
+from .errors import Diagnostic, did_you_mean
+from .fmt import format_expr
+from .library import ActionDef, load_library
+from .model import BoundAction, CheckedBehaviour, CheckedRule, CheckedSpec, TopicUse, Value
+from .paths import PathError, resolve
+from .source import SourceSet, Span
+from .typecheck import ANY, ExprChecker, Resolution, Scope, Ty
+
+
+class _Checker:
+    def __init__(self, spec: ast.Spec, sources: SourceSet) -> None:
+        self.spec, self.sources = spec, sources
+        self.diags: List[Diagnostic] = []
+        self.warnings: List[Diagnostic] = []
+        self.consts: Dict[str, ast.Const] = {}
+        self.const_values: Dict[str, Tuple[ast.Lit, Ty]] = {}
+        self.const_busy: List[str] = []
+        self.entities: Dict[str, ast.Entity] = {}
+        self.rule_asts: Dict[str, ast.Rule] = {}
+        self.used_rules: Dict[str, Set[str]] = {}
+
+    def error(self, span: Span, msg: str) -> None:
+        self.diags.append(Diagnostic(span, msg))
+
+    # -- names ---------------------------------------------------------------------------
+    def collect(self) -> None:
+        top: Dict[str, Span] = {}
+        for d in self.spec.decls:
+            if isinstance(d, (ast.Const, ast.Entity)):
+                kind = "constant" if isinstance(d, ast.Const) else "entity"
+                if d.name.name in top:
+                    self.error(d.name.span, f"duplicate name '{d.name.name}' (a {kind}); first defined at "
+                                            f"{top[d.name.name]}")
+                    continue
+                top[d.name.name] = d.name.span
+                if isinstance(d, ast.Const):
+                    self.consts[d.name.name] = d
+                else:
+                    self.entities[d.name.name] = d
+        for ent in self.entities.values():
+            seen: Dict[str, Span] = {}
+            for r in ent.rules:
+                if r.name.name in seen:
+                    self.error(r.name.span, f"duplicate rule '{r.name.name}' in entity '{ent.name.name}'; "
+                                            f"first defined at {seen[r.name.name]}")
+                    continue
+                if r.name.name in self.consts:
+                    self.error(r.name.span, f"rule '{r.name.name}' has the name of a constant "
+                                            f"(defined at {self.consts[r.name.name].name.span})")
+                seen[r.name.name] = r.name.span
+                self.rule_asts[f"{ent.name.name}.{r.name.name}"] = r
+            nodes: Dict[str, Span] = {}
+            for n in ent.nodes:
+                if n.name in nodes:
+                    self.warnings.append(Diagnostic(n.span, f"node '{n.name}' is listed twice", "warning"))
+                nodes[n.name] = n.span
+            if not ent.rules:
+                self.warnings.append(Diagnostic(ent.name.span, f"entity '{ent.name.name}' has no rules",
+                                                "warning"))
+
+    def resolver(self, entity: Optional[str], user: Optional[str]):  # type: ignore[no-untyped-def]
+        """A name resolver for an expression in `entity` (None: at top level)."""
+
+        def resolve_name(name: ast.Name) -> Resolution:
+            parts = name.parts
+            if len(parts) == 2:
+                ent, rule = parts
+                if ent not in self.entities:
+                    return f"undefined entity '{ent}'{did_you_mean(ent, self.entities)}"
+                key = f"{ent}.{rule}"
+                if key not in self.rule_asts:
+                    names = [r.name.name for r in self.entities[ent].rules]
+                    return f"entity '{ent}' has no rule '{rule}'{did_you_mean(rule, names)}"
+                return self._rule(key, user)
+            (n,) = parts
+            if entity is not None and f"{entity}.{n}" in self.rule_asts:
+                return self._rule(f"{entity}.{n}", user)
+            if n in self.consts:
+                lit, ty = self.const_value(n)
+                return ("const", lit, ty)
+            owners = [k.split(".")[0] for k in self.rule_asts if k.split(".")[1] == n]
+            if owners:
+                return f"'{n}' is a rule of entity '{owners[0]}': write '{owners[0]}.{n}'"
+            if n in self.entities:
+                return f"'{n}' is an entity; name one of its rules: '{n}.RULE'"
+            visible = list(self.consts)
+            if entity is not None:
+                visible += [r.name.name for r in self.entities[entity].rules]
+            return f"undefined name '{n}'{did_you_mean(n, visible)}"
+
+        return resolve_name
+
+    def _rule(self, key: str, user: Optional[str]) -> Resolution:
+        if user is not None:
+            self.used_rules.setdefault(user, set()).add(key)
+        return ("rule", ast.RuleRef(key), Ty("bool"))
+
+    def const_value(self, name: str) -> Tuple[ast.Lit, Ty]:
+        if name in self.const_values:
+            return self.const_values[name]
+        decl = self.consts[name]
+        if name in self.const_busy:
+            cycle = self.const_busy[self.const_busy.index(name):] + [name]
+            self.error(decl.name.span, f"constant '{name}' is defined in terms of itself: {' -> '.join(cycle)}")
+            self.const_values[name] = (ast.Lit(0.0), ANY)
+            return self.const_values[name]
+        self.const_busy.append(name)
+        out, ty = ExprChecker(Scope(self.resolver(None, None), dynamic=False), self.diags).check(decl.expr)
+        self.const_busy.pop()
+        if not isinstance(out, ast.Lit):
+            if not any(d.span.start >= decl.span.start and d.span.file == decl.span.file and
+                       d.span.start <= decl.span.end for d in self.diags):
+                self.error(decl.expr.span, f"constant '{name}' must be computable before the monitor starts")
+            out = ast.Lit(0.0)
+        self.const_values[name] = (out, ty)
+        return out, ty
+
+    # -- rules and cycles ----------------------------------------------------------------
+    def check_rules(self) -> Dict[str, ast.Expr]:
+        checked: Dict[str, ast.Expr] = {}
+        for ent in self.entities.values():
+            nodes = tuple(n.name for n in ent.nodes)
+            for r in ent.rules:
+                key = f"{ent.name.name}.{r.name.name}"
+                if self.rule_asts.get(key) is not r:
+                    continue
+                scope = Scope(self.resolver(ent.name.name, key), nodes=nodes, entity=ent.name.name)
+                checked[key] = ExprChecker(scope, self.diags).condition(r.expr, f"rule '{r.name.name}'")
+        return checked
+
+    def order(self) -> List[str]:
+        """Rule keys, each after the rules it uses; reports cycles."""
+        done: List[str] = []
+        state: Dict[str, int] = {}
+
+        def visit(key: str, path: List[str]) -> None:
+            if state.get(key) == 2:
+                return
+            if state.get(key) == 1:
+                cycle = path[path.index(key):] + [key]
+                self.error(self.rule_asts[key].name.span, f"cyclic rule reference: {' -> '.join(cycle)}")
+                return
+            state[key] = 1
+            for dep in sorted(self.used_rules.get(key, ())):
+                visit(dep, path + [key])
+            state[key] = 2
+            done.append(key)
+
+        for key in self.rule_asts:
+            visit(key, [])
+        return done
+
+    # -- actions -------------------------------------------------------------------------
+    def load_libraries(self, extra: Sequence[str]) -> Tuple[Dict[str, ActionDef], List[str]]:
+        actions: Dict[str, ActionDef] = {}
+        loaded: List[str] = []
+        base = os.path.dirname(os.path.abspath(self.spec.file))
+        wanted: List[Tuple[str, Span]] = []
+        for d in self.spec.decls:
+            if isinstance(d, ast.Import):
+                try:
+                    wanted.append((resolve(d.path, base), d.span))
+                except PathError as exc:
+                    self.error(d.span, f"cannot import '{d.path}': {exc}")
+        wanted += [(os.path.abspath(p), Span(p, 0, 0)) for p in extra]
+        for path, span in wanted:
+            if path in loaded:
+                continue
+            if span.line and not os.path.isfile(path):
+                why = "it is a directory" if os.path.isdir(path) else "no such file"
+                self.error(span, f"cannot import '{path}': {why}")
+                continue
+            lib, diags = load_library(path, self.sources)
+            self.diags.extend(diags)
+            loaded.append(path)
+            for name, act in lib.items():
+                if name in actions:
+                    self.error(act.span, f"action '{name}' is defined again; first defined at {actions[name].span}")
+                else:
+                    actions[name] = act
+        return actions, loaded
+
+    def check_actions(self, library: Dict[str, ActionDef], loaded: List[str]) -> Dict[str, Span]:
+        declared: Dict[str, Span] = {}
+        for d in self.spec.decls:
+            if not isinstance(d, ast.ActionDecl):
+                continue
+            for ident in d.names:
+                if ident.name in declared:
+                    self.warnings.append(Diagnostic(ident.span, f"action '{ident.name}' is declared twice",
+                                                    "warning"))
+                    continue
+                declared[ident.name] = ident.span
+                if ident.name not in library and not self._broken_in_library(ident.name):
+                    where = ("no action library is loaded: add 'import \"actions.yaml\";' or pass --actions"
+                             if not loaded else "loaded: " + ", ".join(loaded))
+                    self.error(ident.span, f"action '{ident.name}' is not defined in any action library "
+                                           f"({where}){did_you_mean(ident.name, library)}")
+        return declared
+
+    def _broken_in_library(self, name: str) -> bool:
+        """True when a library defines `name` but its definition had errors (already reported)."""
+        return any(d.message.startswith(f"action '{name}':") for d in self.diags)
+
+    def check_behaviours(self, declared: Dict[str, Span], library: Dict[str, ActionDef]) -> List[CheckedBehaviour]:
+        out: List[CheckedBehaviour] = []
+        used: Set[str] = set()
+        for d in self.spec.decls:
+            if not isinstance(d, ast.Behaviour):
+                continue
+            index = len(out) + 1
+            scope = Scope(self.resolver(None, None))
+            cond = ExprChecker(scope, self.diags).condition(d.cond, "the condition of 'if'")
+            bound: List[BoundAction] = []
+            for call in d.actions:
+                name = call.name.name
+                used.add(name)
+                if name not in declared:
+                    self.error(call.name.span, f"action '{name}' is not declared: add 'action primitive {name};'"
+                                               f"{did_you_mean(name, declared)}")
+                args: List[Value] = []
+                for a in call.args:
+                    lit, _ = ExprChecker(Scope(self.resolver(None, None), dynamic=False), self.diags).check(a)
+                    if isinstance(lit, ast.Lit):
+                        args.append(lit.value)
+                    else:
+                        self.error(a.span, "an action argument must be a literal or a constant")
+                if name in library:
+                    bound.append(BoundAction(name, library[name], tuple(args), call.span))
+            if not d.actions:
+                self.warnings.append(Diagnostic(d.span, "this behaviour has no actions", "warning"))
+            sig = f"if ({format_expr(cond)}) then {{{' '.join(a.name + repr(a.args) for a in bound)}}}"
+            out.append(CheckedBehaviour(index, cond, tuple(bound), d.span, sig))
+        for name, span in declared.items():
+            if name not in used:
+                self.warnings.append(Diagnostic(span, f"action '{name}' is declared but never used", "warning"))
+        return out
+
+
+def check(spec: ast.Spec, sources: SourceSet, extra_libraries: Sequence[str] = ()) -> Tuple[Optional[CheckedSpec], List[Diagnostic], List[Diagnostic]]:
+    """Check a parsed spec; returns (checked spec or None, errors, warnings)."""
+    c = _Checker(spec, sources)
+    try:
+        c.collect()
+        for name in c.consts:
+            c.const_value(name)
+        checked = c.check_rules()
+        order = c.order()
+        library, loaded = c.load_libraries(extra_libraries)
+        declared = c.check_actions(library, loaded)
+        behaviours = c.check_behaviours(declared, library)
+    except RecursionError:
+        c.error(Span(spec.file, 1, 1), "expressions are nested too deeply to check")
+    if c.diags:
+        c.diags.sort(key=lambda d: (d.span.file != spec.file, d.span.file, d.span.line, d.span.col))
+        return None, c.diags, c.warnings
+    rules = _build_rules(c, checked, order)
+    topics, nodes = _uses([r.expr for r in rules] + [b.cond for b in behaviours])
+    consts = {n: lit.value for n, (lit, _) in c.const_values.items()}
+    return (CheckedSpec(spec.file, spec, rules, behaviours, consts, library, topics, nodes, loaded,
+                        c.warnings, sources), [], c.warnings)
+
+
+def _build_rules(c: _Checker, checked: Dict[str, ast.Expr], order: List[str]) -> List[CheckedRule]:
+    sigs: Dict[str, str] = {}
+    rules: List[CheckedRule] = []
+    for key in order:
+        deps = frozenset(c.used_rules.get(key, ()))
+        text = format_expr(checked[key])
+        sigs[key] = text + "".join(f" [{d}: {sigs[d]}]" for d in sorted(deps))
+        ent, name = key.split(".")
+        rules.append(CheckedRule(key, ent, name, checked[key], c.rule_asts[key].span, deps, sigs[key]))
+    return rules
+
+
+def _uses(exprs: Sequence[ast.Expr]) -> Tuple[Dict[str, TopicUse], FrozenSet[str]]:
+    paths: Dict[str, Set[Tuple[ast.PathElem, ...]]] = {}
+    nodes: Set[str] = set()
+    stack = list(exprs)
+    while stack:
+        e = stack.pop()
+        if isinstance(e, ast.TopicRef):
+            paths.setdefault(e.topic, set())
+            if e.path:
+                paths[e.topic].add(e.path)
+        elif isinstance(e, ast.NodeRef):
+            nodes.add(e.node)
+        stack.extend(ast.children(e))
+    return {t: TopicUse(t, frozenset(p)) for t, p in paths.items()}, frozenset(nodes)

@@ -1,0 +1,57 @@
+"""The error hierarchy: every spec or library problem is a Diagnostic with a place."""
+from __future__ import annotations
+
+import difflib
+from dataclasses import dataclass
+from typing import Iterable, List, Optional, Sequence
+
+from .source import Span, SourceSet
+
+
+@dataclass(frozen=True)
+class Diagnostic:
+    """One message about one place: an error or a warning."""
+
+    span: Span
+    message: str
+    severity: str = "error"
+
+    def render(self, sources: Optional[SourceSet] = None) -> str:
+        """Compiler-style text: header, the source line, a caret under the column."""
+        if self.span.line <= 0:
+            return f"{self.span.file}: {self.severity}: {self.message}"
+        head = f"{self.span}: {self.severity}: {self.message}"
+        src = sources.get(self.span.file) if sources else None
+        if src is None:
+            return head
+        line = src.line_text(self.span.line)
+        if len(line) > 200:
+            lo = max(0, self.span.col - 100)
+            line, col = line[lo:lo + 200], self.span.col - lo
+        else:
+            col = self.span.col
+        line = line.expandtabs(1).replace("\r", " ")
+        caret = " " * (max(col, 1) - 1) + "^"
+        return f"{head}\n    {line}\n    {caret}"
+
+
+class RubassError(Exception):
+    """Base of every error rubass raises on purpose."""
+
+
+class SpecError(RubassError):
+    """A spec, or an action library it uses, has errors; carries all of them."""
+
+    def __init__(self, diagnostics: Sequence[Diagnostic], sources: Optional[SourceSet] = None) -> None:
+        self.diagnostics: List[Diagnostic] = list(diagnostics)
+        self.sources = sources
+        super().__init__(self.render())
+
+    def render(self) -> str:
+        return "\n".join(d.render(self.sources) for d in self.diagnostics)
+
+
+def did_you_mean(name: str, candidates: Iterable[str]) -> str:
+    """A suggestion suffix for an unknown name, or '' when nothing is close."""
+    close = difflib.get_close_matches(name, sorted(set(candidates)), n=1, cutoff=0.6)
+    return f"; did you mean '{close[0]}'?" if close else ""

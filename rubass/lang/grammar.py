@@ -1,0 +1,330 @@
+"""The pyparsing grammar of RuBaSS (LANGUAGE.md §2–4); parse actions build the AST.
+
+Only camelCase pyparsing names are used: they exist in pyparsing 2.4 (ROS Noetic) and 3.x.
+"""
+from __future__ import annotations
+
+import re
+import threading
+from typing import Any, Callable, Dict, List, Optional, Tuple
+
+import pyparsing as pp
+
+from . import ast
+from .errors import Diagnostic, SpecError
+from .source import Source, SourceSet, Span
+
+KEYWORDS = frozenset(
+    "action primitive entity rules if then topic node and or not for true false const import".split()
+)
+FUNCTIONS = frozenset(
+    "abs sqrt min max hypot len frequency age alive cpu memory".split()
+)
+
+_IDENT_RE = r"[A-Za-z_][A-Za-z0-9_]*"
+_GRAPH_RE = rf"~?/?{_IDENT_RE}(?:/{_IDENT_RE})*"
+_PATH_RE = rf"(?:\.{_IDENT_RE}|\[\s*-?\d+\s*\])*"
+_NUM_RE = r"(?:\d+\.\d*|\.\d+|\d+)(?:[eE][-+]?\d+)?"
+_UNIT_RE = r"%|[A-Za-z]+(?:/[A-Za-z]+(?:\^[0-9]+)?)?(?![A-Za-z0-9_])"
+
+
+class _Op:
+    """An operator token with its offset, so a Binary can point at its operator."""
+
+    __slots__ = ("text", "loc")
+
+    def __init__(self, text: str, loc: int) -> None:
+        self.text, self.loc = text, loc
+
+
+class _Ctx(threading.local):
+    source: Optional[Source] = None
+    comments: Dict[int, ast.Comment] = {}
+
+
+_ctx = _Ctx()
+
+
+def _span(loc: int, end: int = -1) -> Span:
+    assert _ctx.source is not None
+    return _ctx.source.span(loc, end)
+
+
+def _fail(s: str, loc: int, msg: str) -> None:
+    raise pp.ParseFatalException(s, loc, msg)
+
+
+def _kw(word: str) -> pp.ParserElement:
+    return pp.Keyword(word).setName(f"'{word}'")
+
+
+def _lit(text: str) -> pp.ParserElement:
+    return pp.Literal(text).setName(f"'{text}'")
+
+
+def _seq(*parts: pp.ParserElement, commit_after: int = 1) -> pp.ParserElement:
+    """parts in order; once the first commit_after parts matched, a failure is a syntax error.
+
+    An explicit flat And with pyparsing's error stop, rather than the '-' operator, whose
+    nested Ands are not always flattened (and then lose the stop).
+    """
+    items = list(parts[:commit_after]) + [pp.And._ErrorStop()] + list(parts[commit_after:])
+    return pp.And(items)
+
+
+def _action(el: pp.ParserElement, fn: Callable[[str, int, Any], Any]) -> pp.ParserElement:
+    return el.addParseAction(fn)
+
+
+def _fold_binary(s: str, loc: int, toks: Any) -> Any:
+    items = list(toks)
+    expr = items[0]
+    for i in range(1, len(items), 2):
+        op = items[i]
+        expr = ast.Binary(op.text, expr, items[i + 1], span=_span(op.loc))
+    return expr
+
+
+def _compare(s: str, loc: int, toks: Any) -> Any:
+    items = list(toks)
+    if len(items) > 3:
+        op = items[3]
+        _fail(s, op.loc, f"comparisons cannot be chained: write '(a {items[1].text} b) and "
+                         f"(b {op.text} c)' instead of 'a {items[1].text} b {op.text} c'")
+    return _fold_binary(s, loc, toks)
+
+
+def _unary(s: str, loc: int, toks: Any) -> Any:
+    op, operand = toks[0], toks[1]
+    if op.text == "-" and isinstance(operand, ast.Num):
+        return ast.Num(-operand.value, operand.unit, span=_span(op.loc))
+    return ast.Unary(op.text, operand, span=_span(op.loc))
+
+
+def _for(s: str, loc: int, toks: Any) -> Any:
+    items = list(toks)
+    expr = items[0]
+    for i in range(1, len(items), 2):
+        expr = ast.For(expr, items[i + 1], span=_span(items[i].loc))
+    return expr
+
+
+def _number(s: str, loc: int, toks: Any) -> Any:
+    unit = toks[1] if len(toks) > 1 else None
+    return ast.Num(float(toks[0]), unit, span=_span(loc))
+
+
+_ESCAPES = {'"': '"', "\\": "\\"}
+
+
+def _string(s: str, loc: int, toks: Any) -> Any:
+    body = toks[0][1:-1]
+    out: List[str] = []
+    i = 0
+    while i < len(body):
+        ch = body[i]
+        if ch == "\\":
+            nxt = body[i + 1] if i + 1 < len(body) else ""
+            if nxt not in _ESCAPES:
+                _fail(s, loc + 1 + i, f"unknown escape '\\{nxt}' in string (only \\\" and \\\\)")
+            out.append(_ESCAPES[nxt])
+            i += 2
+        else:
+            out.append(ch)
+            i += 1
+    return ast.Str("".join(out), span=_span(loc))
+
+
+def _topic(s: str, loc: int, toks: Any) -> Any:
+    text = toks[1]
+    m = re.match(_GRAPH_RE, text)
+    assert m is not None
+    path: List[ast.PathElem] = []
+    for part in re.findall(rf"\.({_IDENT_RE})|\[\s*(-?\d+)\s*\]", text[m.end():]):
+        path.append(part[0] if part[0] else int(part[1]))
+    return ast.TopicRef(m.group(0), tuple(path), span=_span(loc))
+
+
+def _name(s: str, loc: int, toks: Any) -> Any:
+    parts = tuple(toks[0].split("."))
+    for p in parts:
+        if p in KEYWORDS:
+            _fail(s, loc, f"'{p}' is a keyword and cannot be used as a name")
+    return ast.Name(parts, span=_span(loc))
+
+
+def _ident(s: str, loc: int, toks: Any) -> Any:
+    return ast.Ident(toks[0], span=_span(loc))
+
+
+def _not_keyword(s: str, loc: int, toks: Any) -> bool:
+    return toks[0] not in KEYWORDS
+
+
+def _comment(s: str, loc: int, toks: Any) -> Any:
+    line_start = s.rfind("\n", 0, loc) + 1
+    own_line = not s[line_start:loc].strip()
+    _ctx.comments[loc] = ast.Comment(toks[0], own_line, span=_span(loc, loc + len(toks[0])))
+    return []
+
+
+def _loc_token(text: str) -> pp.ParserElement:
+    """A punctuation token that yields its offset, to give statements an end position."""
+    return _action(_lit(text), lambda s, loc, t: [_Op(text, loc)])
+
+
+def _build() -> pp.ParserElement:
+    LPAR, RPAR = (pp.Suppress(_lit(c)).setName(f"'{c}'") for c in "()")
+    SEMI = _loc_token(";").setName("';'")
+    LBRACE, RBRACE = pp.Suppress(_lit("{")).setName("'{'"), _loc_token("}")
+    COLON = pp.Suppress(_lit(":")).setName("':'")
+
+    def keyword_as_name(s: str, loc: int, toks: Any) -> None:
+        if toks[0] in KEYWORDS:
+            _fail(s, loc, f"'{toks[0]}' is a keyword and cannot be used as a name")
+
+    ident_node = _action(_action(pp.Regex(_IDENT_RE).setName("name"), keyword_as_name), _ident)
+
+    def op(*texts: str) -> pp.ParserElement:
+        alts = [(_kw(t) if t.isalpha() else _lit(t)) for t in texts]
+        el = alts[0]
+        for a in alts[1:]:
+            el = el | a
+        return _action(el, lambda s, loc, t: [_Op(t[0], loc)])
+
+    number = _action(
+        pp.Regex(_NUM_RE).setName("number")
+        + pp.Optional(pp.Regex(_UNIT_RE).setName("unit").addCondition(_not_keyword)),
+        _number,
+    )
+    string = (
+        _action(pp.Regex(r'"(?:[^"\\\n]|\\.)*"'), _string)
+        | _action(pp.Regex(r'"[^\n]*'), lambda s, loc, t: _fail(s, loc, "unterminated string"))
+    ).setName("string")
+    true = _action(_kw("true"), lambda s, loc, t: ast.Bool(True, span=_span(loc)))
+    false = _action(_kw("false"), lambda s, loc, t: ast.Bool(False, span=_span(loc)))
+    topic = _action(
+        _seq(_kw("topic"), pp.Regex(_GRAPH_RE + _PATH_RE).setName("topic name")), _topic
+    )
+    node = _action(
+        _seq(_kw("node"), pp.Regex(_GRAPH_RE).setName("node name")),
+        lambda s, loc, t: ast.NodeRef(t[1], span=_span(loc)),
+    )
+    expr = pp.Forward().setName("expression")
+    call = _action(
+        _seq(pp.Regex(_IDENT_RE), pp.FollowedBy(_lit("(")), LPAR,
+             pp.Optional(pp.delimitedList(expr)), RPAR, commit_after=3),
+        lambda s, loc, t: ast.Call(t[0], tuple(t[1:]), span=_span(loc)),
+    )
+    name = _action(pp.Regex(rf"{_IDENT_RE}(?:\.{_IDENT_RE})?").addCondition(_not_keyword), _name)
+    primary = (
+        true | false | number | string | topic | node | call | name | _seq(LPAR, expr, RPAR)
+    ).setName("expression")
+    unary = pp.Forward().setName("expression")
+    unary <<= (_action(op("-") + unary, _unary) | primary).setName("expression")
+    mul = _action(unary + pp.ZeroOrMore(_seq(op("*", "/"), unary)), _fold_binary)
+    add = _action(mul + pp.ZeroOrMore(_seq(op("+", "-"), mul)), _fold_binary)
+    cmp = _action(add + pp.ZeroOrMore(_seq(op("<=", ">=", "==", "!=", "<", ">"), add)), _compare)
+    neg = pp.Forward().setName("expression")
+    neg <<= (_action(_seq(op("not"), neg), _unary) | cmp).setName("expression")
+    conj = _action(neg + pp.ZeroOrMore(_seq(op("and"), neg)), _fold_binary)
+    disj = _action(conj + pp.ZeroOrMore(_seq(op("or"), conj)), _fold_binary)
+    for_hint = _action(
+        op("and", "or"),
+        lambda s, loc, t: _fail(
+            s, loc, f"'for' applies to everything on its left; to combine its result, put it in "
+                    f"parentheses: '(A for T) {t[0].text} B'"),
+    )
+    duration = unary.copy().setName("duration (e.g. 0.4 s)")
+    for_expr = _action(disj + pp.ZeroOrMore(_seq(op("for"), duration, pp.Optional(for_hint))), _for)
+    expr <<= for_expr
+
+    def stmt(el: pp.ParserElement, fn: Callable[[Span, List[Any]], Any]) -> pp.ParserElement:
+        def act(s: str, loc: int, toks: Any) -> Any:
+            items = list(toks)
+            end = loc
+            for it in items:
+                if isinstance(it, _Op) and it.text in ";}":
+                    end = max(end, it.loc + 1)
+            items = [i for i in items if not isinstance(i, (_Op, str))]  # punctuation, keywords
+            return fn(_span(loc, end), items)
+        return _action(el, act)
+
+    import_stmt = stmt(
+        _seq(_kw("import"), string, SEMI), lambda sp, t: ast.Import(t[0].value, span=sp))
+    action_decl = stmt(
+        _seq(_kw("action"), _kw("primitive"), pp.delimitedList(ident_node), SEMI),
+        lambda sp, t: ast.ActionDecl(tuple(t), span=sp))
+    const_decl = stmt(
+        _seq(_kw("const"), ident_node, pp.Suppress(_lit("=")).setName("'='"), expr, SEMI),
+        lambda sp, t: ast.Const(t[0], t[1], span=sp))
+    rule = stmt(_seq(ident_node, COLON, expr, SEMI, commit_after=2), lambda sp, t: ast.Rule(t[0], t[1], span=sp))
+    node_name = _action(pp.Regex(_GRAPH_RE).setName("node name"), _ident)
+    header = pp.Group(pp.Optional(_seq(COLON, pp.delimitedList(node_name))))
+    entity = stmt(
+        _seq(_kw("entity"), ident_node, header, pp.Optional(pp.Suppress(_lit(";"))),
+             LBRACE, pp.Suppress(_kw("rules")), COLON, pp.Group(pp.ZeroOrMore(rule)),
+             RBRACE.copy().setName("'}' or a rule 'name: expression;'"), pp.Optional(SEMI)),
+        lambda sp, t: ast.Entity(t[0], tuple(t[1]), tuple(t[2]), span=sp))
+    args = pp.Group(pp.Optional(_seq(LPAR, pp.Optional(pp.delimitedList(expr)), RPAR)))
+    action_call = stmt(
+        _seq(ident_node, args, SEMI, commit_after=2), lambda sp, t: ast.ActionCall(t[0], tuple(t[1]), span=sp))
+    behaviour = stmt(
+        _seq(_kw("if"), LPAR, expr, RPAR, _kw("then"), LBRACE, pp.Group(pp.ZeroOrMore(action_call)),
+             RBRACE.copy().setName("'}' or an action 'name;'"), pp.Optional(SEMI)),
+        lambda sp, t: ast.Behaviour(t[0], tuple(t[1]), span=sp))
+    decl = import_stmt | action_decl | const_decl | entity | behaviour
+    end = pp.StringEnd().setName("a declaration (import, action, const, entity or if)")
+    spec = _seq(pp.ZeroOrMore(decl), end)
+    comment = _action(pp.Regex(r"//[^\n]*|/\*[\s\S]*?\*/"), _comment)
+    spec.ignore(comment)
+    return spec
+
+
+_GRAMMAR: Optional[pp.ParserElement] = None
+_LOCK = threading.Lock()
+
+
+def _found(text: str, loc: int) -> str:
+    if loc >= len(text):
+        return "end of file"
+    m = re.match(r"\S{1,20}", text[loc:])
+    return f"'{m.group(0)}'" if m else "end of file"
+
+
+def parse_source(source: Source) -> ast.Spec:
+    """Parse one source file into a Spec; raises SpecError for a syntax error."""
+    global _GRAMMAR
+    with _LOCK:
+        if _GRAMMAR is None:
+            _GRAMMAR = _build()
+        _ctx.source, _ctx.comments = source, {}
+        try:
+            toks = _GRAMMAR.parseString(source.text, parseAll=True)
+        except pp.ParseBaseException as exc:
+            msg = exc.msg
+            if msg.startswith("Expected "):
+                msg = f"expected {msg[len('Expected '):]}, found {_found(source.text, exc.loc)}"
+            if source.text.startswith("/*", exc.loc):
+                msg = "unterminated comment '/*'"
+            raise _error(source, exc.loc, msg) from None
+        except RecursionError:
+            raise _error(source, 0, "expressions are nested too deeply to parse") from None
+        finally:
+            comments = sorted(_ctx.comments.values(), key=lambda c: c.span.start)
+            _ctx.source, _ctx.comments = None, {}
+    return ast.Spec(tuple(toks), tuple(comments), file=source.name)
+
+
+def _error(source: Source, loc: int, msg: str) -> SpecError:
+    sources = SourceSet()
+    sources.add(source)
+    return SpecError([Diagnostic(source.span(loc), msg)], sources)
+
+
+def parse_text(text: str, name: str = "<string>") -> ast.Spec:
+    """Parse spec text (for tests and tools); raises SpecError."""
+    return parse_source(Source(name, text))
+
+
+__all__: Tuple[str, ...] = ("KEYWORDS", "FUNCTIONS", "parse_source", "parse_text")

@@ -1,0 +1,253 @@
+"""Action libraries (LANGUAGE.md §8): YAML files validated key by key, errors with places."""
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass, field
+from typing import Any, Callable, Dict, List, Optional, Tuple
+
+import yaml
+
+from .errors import Diagnostic, did_you_mean
+from .grammar import KEYWORDS
+from .source import Source, SourceSet, Span
+from .units import FREQUENCY, TIME, Dimension, parse_quantity
+
+BUILTIN_PLUGINS = ("publish", "serial", "service", "log")
+CUSTOM_PLUGIN_RE = re.compile(r"[A-Za-z_][A-Za-z0-9_]*(?:\.[A-Za-z_][A-Za-z0-9_]*)*:[A-Za-z_][A-Za-z0-9_]*")
+MSG_TYPE_RE = re.compile(r"[A-Za-z_][A-Za-z0-9_]*/[A-Za-z_][A-Za-z0-9_]*")
+LOG_LEVELS = ("debug", "info", "warn", "error")
+PHASES = ("start", "hold", "release")
+
+
+@dataclass(frozen=True)
+class ActionDef:
+    """One action of a library: its plugin and its validated, SI-normalised parameters."""
+
+    name: str
+    plugin: str
+    params: Dict[str, Any] = field(compare=False)
+    latch: bool = False
+    span: Span = field(default=Span("<none>", 0, 0), compare=False)
+
+    @property
+    def is_custom(self) -> bool:
+        return ":" in self.plugin
+
+
+class _Node:
+    """A composed YAML node with its place, converted to Python on demand."""
+
+    def __init__(self, node: yaml.Node, file: str) -> None:
+        self.node, self.file = node, file
+
+    @property
+    def span(self) -> Span:
+        mark = self.node.start_mark
+        return Span(self.file, mark.line + 1, mark.column + 1, mark.index, self.node.end_mark.index)
+
+    def value(self) -> Any:
+        return yaml.SafeLoader("").construct_object(self.node, deep=True)
+
+
+Checker = Callable[[_Node, str], Tuple[Any, Optional[str]]]
+
+
+def _string(pattern: Optional["re.Pattern[str]"] = None, what: str = "a string") -> Checker:
+    def check(n: _Node, key: str) -> Tuple[Any, Optional[str]]:
+        v = n.value()
+        if not isinstance(v, str) or (pattern is not None and not pattern.fullmatch(v)):
+            return None, f"'{key}' must be {what}, got {v!r}"
+        return v, None
+    return check
+
+
+def _choice(options: Tuple[str, ...]) -> Checker:
+    def check(n: _Node, key: str) -> Tuple[Any, Optional[str]]:
+        v = n.value()
+        if v not in options:
+            return None, f"'{key}' must be one of {', '.join(options)}, got {v!r}{did_you_mean(str(v), options)}"
+        return v, None
+    return check
+
+
+def _phases(n: _Node, key: str) -> Tuple[Any, Optional[str]]:
+    v = n.value()
+    if isinstance(v, str):
+        v = [v]
+    if not isinstance(v, list) or not v or any(p not in PHASES for p in v):
+        return None, f"'{key}' must be a list of {', '.join(PHASES)}, got {v!r}"
+    return tuple(v), None
+
+
+def _bool(n: _Node, key: str) -> Tuple[Any, Optional[str]]:
+    v = n.value()
+    if not isinstance(v, bool):
+        return None, f"'{key}' must be true or false, got {v!r}"
+    return v, None
+
+
+def _int(n: _Node, key: str) -> Tuple[Any, Optional[str]]:
+    v = n.value()
+    if isinstance(v, bool) or not isinstance(v, int) or v <= 0:
+        return None, f"'{key}' must be a positive integer, got {v!r}"
+    return v, None
+
+
+def _mapping(n: _Node, key: str) -> Tuple[Any, Optional[str]]:
+    v = n.value()
+    if v is None:
+        return {}, None
+    if not isinstance(v, dict):
+        return None, f"'{key}' must be a mapping of message fields, got {v!r}"
+    return v, None
+
+
+def _quantity(d: Dimension, unit: str, example: str) -> Checker:
+    def check(n: _Node, key: str) -> Tuple[Any, Optional[str]]:
+        v = n.value()
+        q = parse_quantity(str(v)) if isinstance(v, (int, float, str)) and not isinstance(v, bool) else None
+        if q is None or (q[1] and q[1] != d) or q[0] <= 0:
+            return None, f"'{key}' must be a positive {unit} such as '{example}', got {v!r}"
+        return q[0], None
+    return check
+
+
+_COMMON: Dict[str, Checker] = {"latch": _bool, "description": _string()}
+
+# plugin -> {key: (checker, required, default)}
+SCHEMAS: Dict[str, Dict[str, Tuple[Checker, bool, Any]]] = {
+    "publish": {
+        "topic": (_string(re.compile(r"~?/?[A-Za-z_][\w/]*"), "a topic name"), True, None),
+        "type": (_string(MSG_TYPE_RE, "a message type 'package/Type'"), True, None),
+        "message": (_mapping, False, {}),
+        "on_release": (_mapping, False, None),
+        "rate": (_quantity(FREQUENCY, "frequency", "20 Hz"), False, 10.0),
+    },
+    "serial": {
+        "port": (_string(re.compile(r"\S+"), "a device path"), True, None),
+        "baud": (_int, False, 115200),
+        "on_start": (_string(), False, None),
+        "on_hold": (_string(), False, None),
+        "on_release": (_string(), False, None),
+        "write_timeout": (_quantity(TIME, "time", "0.1 s"), False, 0.1),
+    },
+    "service": {
+        "service": (_string(re.compile(r"~?/?[A-Za-z_][\w/]*"), "a service name"), True, None),
+        "type": (_string(MSG_TYPE_RE, "a service type 'package/Type'"), True, None),
+        "request": (_mapping, False, {}),
+        "timeout": (_quantity(TIME, "time", "1 s"), False, 1.0),
+        "call_on": (_phases, False, ("start",)),
+    },
+    "log": {
+        "level": (_choice(LOG_LEVELS), False, "warn"),
+        "message": (_string(), False, None),
+    },
+}
+
+
+def load_library(path: str, sources: SourceSet) -> Tuple[Dict[str, ActionDef], List[Diagnostic]]:
+    """Read and validate one library file; returns its valid actions and every problem found.
+
+    An action whose definition has errors is left out; its name is still in the diagnostics.
+    """
+    from .sourcefile import read_source
+
+    src, diag = read_source(path, what="action library")
+    if src is None:
+        return {}, [diag] if diag else []
+    sources.add(src)
+    return parse_library(src)
+
+
+def parse_library(src: Source) -> Tuple[Dict[str, ActionDef], List[Diagnostic]]:
+    """Validate library text already read; positions point into src."""
+    diags: List[Diagnostic] = []
+    try:
+        root = yaml.compose(src.text, Loader=yaml.SafeLoader)
+    except yaml.YAMLError as exc:
+        mark = getattr(exc, "problem_mark", None)
+        problem = getattr(exc, "problem", None) or str(exc)
+        span = Span(src.name, mark.line + 1, mark.column + 1) if mark else Span(src.name, 1, 1)
+        return {}, [Diagnostic(span, f"invalid YAML: {problem}")]
+    except (ValueError, RecursionError) as exc:  # e.g. NUL bytes, absurd nesting
+        return {}, [Diagnostic(Span(src.name, 1, 1), f"invalid YAML: {exc}")]
+    top = Span(src.name, 1, 1)
+    if not isinstance(root, yaml.MappingNode):
+        return {}, [Diagnostic(top, "an action library must be a mapping with a key 'actions'")]
+    entries = {_key(k): (k, v) for k, v in root.value}
+    if "actions" not in entries:
+        return {}, [Diagnostic(top, "an action library needs a top-level key 'actions'")]
+    for key, (knode, _) in entries.items():
+        if key != "actions":
+            diags.append(Diagnostic(_Node(knode, src.name).span,
+                                    f"unknown top-level key '{key}' (expected 'actions')"))
+    actions_node = entries["actions"][1]
+    if not isinstance(actions_node, yaml.MappingNode):
+        return {}, diags + [Diagnostic(_Node(actions_node, src.name).span,
+                                       "'actions' must be a mapping from action names to definitions")]
+    out: Dict[str, ActionDef] = {}
+    for knode, vnode in actions_node.value:
+        name, kspan = _key(knode), _Node(knode, src.name).span
+        if not re.fullmatch(r"[A-Za-z_][A-Za-z0-9_]*", name) or name in KEYWORDS:
+            diags.append(Diagnostic(kspan, f"'{name}' is not a valid action name (a RuBaSS identifier)"))
+            continue
+        if name in out:
+            diags.append(Diagnostic(kspan, f"action '{name}' is defined twice in this library"))
+            continue
+        action, problems = _action(name, kspan, _Node(vnode, src.name), src.name)
+        diags.extend(problems)
+        if action is not None:
+            out[name] = action
+    return out, diags
+
+
+def _key(node: yaml.Node) -> str:
+    return str(node.value) if isinstance(node, yaml.ScalarNode) else "<complex key>"
+
+
+def _action(name: str, span: Span, node: _Node, file: str) -> Tuple[Optional[ActionDef], List[Diagnostic]]:
+    where = f"action '{name}'"
+    if not isinstance(node.node, yaml.MappingNode):
+        return None, [Diagnostic(node.span, f"{where}: its definition must be a mapping with a 'plugin' key")]
+    fields = {_key(k): (_Node(k, file), _Node(v, file)) for k, v in node.node.value}
+    if "plugin" not in fields:
+        return None, [Diagnostic(span, f"{where}: missing key 'plugin' (one of {', '.join(BUILTIN_PLUGINS)}, "
+                                       "or 'package.module:Class')")]
+    pnode = fields["plugin"][1]
+    plugin = pnode.value()
+    if not isinstance(plugin, str) or (plugin not in BUILTIN_PLUGINS and not CUSTOM_PLUGIN_RE.fullmatch(plugin)):
+        hint = did_you_mean(str(plugin), BUILTIN_PLUGINS)
+        return None, [Diagnostic(pnode.span, f"{where}: unknown plugin {plugin!r} (built-ins: "
+                                             f"{', '.join(BUILTIN_PLUGINS)}; custom: 'package.module:Class'){hint}")]
+    diags: List[Diagnostic] = []
+    params: Dict[str, Any] = {}
+    schema = SCHEMAS.get(plugin, {})
+    for key, (knode, vnode) in fields.items():
+        if key == "plugin":
+            continue
+        checker = _COMMON.get(key) or (schema[key][0] if key in schema else None)
+        if checker is None:
+            if ":" in plugin:  # a custom plugin takes any parameters
+                params[key] = vnode.value()
+                continue
+            known = list(schema) + list(_COMMON)
+            diags.append(Diagnostic(knode.span, f"{where}: unknown key '{key}' for plugin '{plugin}'"
+                                                f"{did_you_mean(key, known)}"))
+            continue
+        value, problem = checker(vnode, key)
+        if problem:
+            diags.append(Diagnostic(vnode.span, f"{where}: {problem}"))
+        else:
+            params[key] = value
+    for key, (_, required, default) in schema.items():
+        if key not in fields:
+            if required:
+                diags.append(Diagnostic(span, f"{where}: missing key '{key}' (plugin '{plugin}' needs it)"))
+            else:
+                params[key] = default
+    if plugin == "serial" and not any(params.get(k) for k in ("on_start", "on_hold", "on_release")):
+        diags.append(Diagnostic(span, f"{where}: a serial action needs at least one of on_start, on_hold, on_release"))
+    if diags:
+        return None, diags
+    latch = bool(params.pop("latch", False))
+    return ActionDef(name, plugin, params, latch, span), []

@@ -1,0 +1,85 @@
+"""The checked spec: what the engine and the monitor run, with every name resolved."""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Dict, FrozenSet, List, Tuple, Union
+
+from . import ast
+from .errors import Diagnostic
+from .library import ActionDef
+from .source import Span, SourceSet
+
+Value = Union[float, bool, str]
+
+
+@dataclass(frozen=True)
+class CheckedRule:
+    """A rule: key 'entity.rule', its checked expression, and what it depends on."""
+
+    key: str
+    entity: str
+    name: str
+    expr: ast.Expr
+    span: Span
+    rule_deps: FrozenSet[str]
+    signature: str  # canonical text of the rule and of every rule it uses (for live reload)
+
+
+@dataclass(frozen=True)
+class BoundAction:
+    """An action call in a behaviour: the library action and its literal arguments."""
+
+    name: str
+    action: ActionDef
+    args: Tuple[Value, ...]
+    span: Span
+
+
+@dataclass(frozen=True)
+class CheckedBehaviour:
+    """`if (cond) then {…}`; index is 1-based in file order."""
+
+    index: int
+    cond: ast.Expr
+    actions: Tuple[BoundAction, ...]
+    span: Span
+    signature: str
+
+    @property
+    def latched(self) -> bool:
+        return any(a.action.latch for a in self.actions)
+
+
+@dataclass(frozen=True)
+class TopicUse:
+    """How a spec uses a topic: the field paths it reads (none: only age/frequency)."""
+
+    topic: str
+    paths: FrozenSet[Tuple[ast.PathElem, ...]]
+
+    @property
+    def needs_data(self) -> bool:
+        return bool(self.paths)
+
+
+@dataclass
+class CheckedSpec:
+    """A spec that passed every check; rules are in dependency order (used before users)."""
+
+    path: str
+    spec: ast.Spec
+    rules: List[CheckedRule]
+    behaviours: List[CheckedBehaviour]
+    consts: Dict[str, Value]
+    actions: Dict[str, ActionDef]
+    topics: Dict[str, TopicUse]
+    nodes: FrozenSet[str]
+    libraries: List[str]
+    warnings: List[Diagnostic] = field(default_factory=list)
+    sources: SourceSet = field(default_factory=SourceSet)
+
+    def rule(self, key: str) -> CheckedRule:
+        for r in self.rules:
+            if r.key == key:
+                return r
+        raise KeyError(key)

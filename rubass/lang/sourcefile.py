@@ -1,0 +1,50 @@
+"""Reading spec and library files: every way a file can be unusable becomes one Diagnostic."""
+from __future__ import annotations
+
+import os
+from typing import Optional, Tuple
+
+from .errors import Diagnostic
+from .source import Source, Span
+
+MAX_BYTES = 4 * 1024 * 1024
+
+
+def read_source(path: str, what: str = "spec") -> Tuple[Optional[Source], Optional[Diagnostic]]:
+    """The file as a Source, or None and a diagnostic that says what is wrong with it."""
+    here = Span(path, 0, 0)
+    try:
+        if os.path.isdir(path):
+            return None, Diagnostic(here, f"cannot read {what}: it is a directory")
+        size = os.path.getsize(path)
+        if size > MAX_BYTES:
+            return None, Diagnostic(here, f"cannot read {what}: {size} bytes is over the limit of "
+                                          f"{MAX_BYTES} bytes")
+        with open(path, "rb") as fh:
+            data = fh.read(MAX_BYTES + 1)
+    except FileNotFoundError:
+        return None, Diagnostic(here, f"cannot read {what}: no such file")
+    except PermissionError:
+        return None, Diagnostic(here, f"cannot read {what}: permission denied")
+    except OSError as exc:
+        return None, Diagnostic(here, f"cannot read {what}: {exc.strerror or exc}")
+    return decode_source(path, data, what)
+
+
+def decode_source(name: str, data: bytes, what: str = "spec") -> Tuple[Optional[Source], Optional[Diagnostic]]:
+    """Bytes to a Source: UTF-8 text without NUL bytes, or a diagnostic at the bad byte."""
+    if data.startswith(b"\xef\xbb\xbf"):
+        data = data[3:]
+    try:
+        text = data.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        good = Source(name, data[: exc.start].decode("utf-8"))
+        line, col = good.position(len(good.text))
+        return None, Diagnostic(Span(name, line, col), f"{what} is not UTF-8 text: invalid byte "
+                                                       f"0x{data[exc.start]:02x}")
+    nul = text.find("\x00")
+    if nul >= 0:
+        src = Source(name, text)
+        line, col = src.position(nul)
+        return None, Diagnostic(Span(name, line, col), f"{what} is not text: it contains a NUL byte")
+    return Source(name, text.replace("\r\n", "\n")), None

@@ -1,0 +1,89 @@
+"""Physical units: the table of LANGUAGE.md §7, normalised to SI, with dimensions."""
+from __future__ import annotations
+
+from typing import Dict, Optional, Tuple
+
+# A dimension is a sorted tuple of (base, exponent); bases: m, s, rad, B.
+Dimension = Tuple[Tuple[str, int], ...]
+
+DIMENSIONLESS: Dimension = ()
+
+
+def dim(**exps: int) -> Dimension:
+    """Build a dimension from base exponents, e.g. dim(m=1, s=-1)."""
+    return tuple(sorted((k, v) for k, v in exps.items() if v))
+
+
+def dim_mul(a: Dimension, b: Dimension, sign: int = 1) -> Dimension:
+    """The dimension of a*b (sign=1) or a/b (sign=-1)."""
+    out: Dict[str, int] = dict(a)
+    for base, exp in b:
+        out[base] = out.get(base, 0) + sign * exp
+    return dim(**out)
+
+
+def dim_sqrt(a: Dimension) -> Optional[Dimension]:
+    """The dimension of sqrt(a), or None when an exponent is odd."""
+    if any(exp % 2 for _, exp in a):
+        return None
+    return tuple((base, exp // 2) for base, exp in a)
+
+
+TIME = dim(s=1)
+LENGTH = dim(m=1)
+SPEED = dim(m=1, s=-1)
+FREQUENCY = dim(s=-1)
+MEMORY = dim(B=1)
+
+_NAMES = {
+    (): "share",
+    TIME: "time",
+    LENGTH: "length",
+    SPEED: "speed",
+    dim(m=1, s=-2): "acceleration",
+    dim(rad=1): "angle",
+    dim(rad=1, s=-1): "angular speed",
+    FREQUENCY: "frequency",
+    MEMORY: "memory",
+}
+
+# unit -> (factor to SI, dimension)
+UNITS: Dict[str, Tuple[float, Dimension]] = {
+    "s": (1.0, TIME), "sec": (1.0, TIME), "ms": (1e-3, TIME), "us": (1e-6, TIME),
+    "min": (60.0, TIME), "h": (3600.0, TIME),
+    "m": (1.0, LENGTH), "cm": (1e-2, LENGTH), "mm": (1e-3, LENGTH), "km": (1e3, LENGTH),
+    "m/s": (1.0, SPEED), "cm/s": (1e-2, SPEED), "km/h": (1000.0 / 3600.0, SPEED),
+    "m/s^2": (1.0, dim(m=1, s=-2)),
+    "rad": (1.0, dim(rad=1)), "deg": (3.141592653589793 / 180.0, dim(rad=1)),
+    "rad/s": (1.0, dim(rad=1, s=-1)), "deg/s": (3.141592653589793 / 180.0, dim(rad=1, s=-1)),
+    "Hz": (1.0, FREQUENCY), "kHz": (1e3, FREQUENCY),
+    "%": (1e-2, DIMENSIONLESS),
+    "B": (1.0, MEMORY), "kB": (1e3, MEMORY), "MB": (1e6, MEMORY), "GB": (1e9, MEMORY),
+    "KiB": (1024.0, MEMORY), "MiB": (1024.0 ** 2, MEMORY), "GiB": (1024.0 ** 3, MEMORY),
+}
+
+
+def dimension_name(d: Dimension) -> str:
+    """A readable name: 'time', 'speed', or a formula such as 'm^2'."""
+    if d in _NAMES:
+        return _NAMES[d]
+    return "*".join(base if exp == 1 else f"{base}^{exp}" for base, exp in d)
+
+
+def parse_quantity(text: str) -> Optional[Tuple[float, Dimension]]:
+    """'20 Hz', '0.5s', '3' -> (SI value, dimension); None when it is not a quantity.
+
+    A bare number gets the dimension None's stand-in DIMENSIONLESS; used for YAML fields.
+    """
+    import re
+
+    m = re.fullmatch(r"\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*(\S*)\s*", text)
+    if not m:
+        return None
+    value = float(m.group(1))
+    if not m.group(2):
+        return value, DIMENSIONLESS
+    unit = UNITS.get(m.group(2))
+    if unit is None:
+        return None
+    return value * unit[0], unit[1]
