@@ -182,7 +182,8 @@ class _Checker:
                 continue
             lib, diags = load_library(path, self.sources)
             self.diags.extend(diags)
-            loaded.append(path)
+            if self.sources.get(path) is not None:  # read, even if some actions were invalid
+                loaded.append(path)
             for name, act in lib.items():
                 if name in actions:
                     self.error(act.span, f"action '{name}' is defined again; first defined at {actions[name].span}")

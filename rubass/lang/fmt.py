@@ -110,7 +110,7 @@ class _Comments:
         self.leading: Dict[int, List[str]] = {}
         self.trailing: Dict[int, str] = {}
         self.footer: Dict[int, List[str]] = {}  # before an entity's '}' (key) or file end (-1)
-        self.header: Dict[int, List[str]] = {}  # after an entity's 'rules:'
+        self.header: Dict[int, List[str]] = {}  # after an entity's 'rules:' ('&': same line)
         if not spec.comments:
             return
         stmts: List[Tuple[int, int, int]] = []  # (start, end, owner entity start or -1)
@@ -134,7 +134,10 @@ class _Comments:
         if inside:
             ent = inside[0]
             if not ent.rules or pos < ent.rules[0].span.start:
-                self.header.setdefault(ent.span.start, []).append(c.text)
+                if c.own_line and ent.rules:
+                    self.leading.setdefault(ent.rules[0].span.start, []).append(c.text)
+                else:
+                    self.header.setdefault(ent.span.start, []).append(("" if c.own_line else "&") + c.text)
                 return
             later = [r for r in ent.rules if r.span.end > pos]
             if later:
@@ -184,10 +187,11 @@ def _decl(d: ast.Decl, com: _Comments) -> List[str]:
 def _entity(d: ast.Entity, com: _Comments) -> List[str]:
     nodes = f": {', '.join(n.name for n in d.nodes)}" if d.nodes else ""
     lines = [f"entity {d.name.name}{nodes} {{", "  rules:"]
-    header = com.header.get(d.span.start, [])
-    if header:
-        lines[-1] += "  " + header[0]
-        lines.extend("    " + h for h in header[1:])
+    for h in com.header.get(d.span.start, []):  # '&': it stood on the 'rules:' line
+        if h.startswith("&") and len(lines) == 2:
+            lines[-1] += "  " + h[1:]
+        else:
+            lines.append("    " + h.lstrip("&"))
     for r in d.rules:
         lines.extend("    " + c for c in com.leading.get(r.span.start, []))
         one = f"    {r.name.name}: {format_expr(r.expr)};"

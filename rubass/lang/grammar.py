@@ -297,7 +297,7 @@ def parse_source(source: Source) -> ast.Spec:
     global _GRAMMAR
     with _LOCK:
         if _GRAMMAR is None:
-            _GRAMMAR = _build()
+            _GRAMMAR = _build().parseWithTabs()
         _ctx.source, _ctx.comments = source, {}
         try:
             toks = _GRAMMAR.parseString(source.text, parseAll=True)
