@@ -5,7 +5,7 @@ import re
 
 import pytest
 
-from rubass.lang import check_text, load_spec, parse_text
+from rubass.lang import check_text, load_spec
 
 from conftest import ROOT, shared_path
 

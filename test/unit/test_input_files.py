@@ -1,5 +1,4 @@
 """Every kind of unusable input file gets one clean error from the CLI, never a traceback."""
-import os
 import subprocess
 import sys
 
