@@ -1,0 +1,237 @@
+"""The rule engine: fed events with their times, it answers with what changed.
+
+Time is always an argument; the engine reads no clock. A message re-evaluates only the rules
+that depend on its topic (and the rules and behaviours that use those), in dependency order.
+`for` timers report their deadlines; `next_deadline()` tells the caller when to wake.
+"""
+from __future__ import annotations
+
+import heapq
+from dataclasses import dataclass
+from typing import Any, Dict, Iterable, List, Optional, Set, Tuple
+
+from ..lang import ast
+from ..lang.model import CheckedBehaviour, CheckedSpec
+from .evaluate import Compiled, Compiler
+from .fields import FieldError, extract
+from .store import Store
+from .values import UNKNOWN
+
+
+@dataclass(frozen=True)
+class Event:
+    """A change: a behaviour's start/hold/release, or a rule's new value ('rule')."""
+
+    time: float
+    kind: str
+    behaviour: int = 0  # 1-based, in file order
+    rule: str = ""
+    value: Any = None
+    actions: Tuple[str, ...] = ()
+    line: int = 0
+
+
+@dataclass
+class _Plan:
+    """What one kind of input makes the engine re-evaluate, in dependency order."""
+
+    rules: Tuple[int, ...]
+    behaviours: Tuple[int, ...]
+
+
+class _Behaviour:
+    def __init__(self, checked: CheckedBehaviour, compiled: Compiled) -> None:
+        self.checked, self.compiled = checked, compiled
+        self.active = False
+        self.value: Any = UNKNOWN
+        self.actions = tuple(a.name for a in checked.actions)
+
+
+def _walk(expr: ast.Expr) -> Iterable[ast.Expr]:
+    stack = [expr]
+    while stack:
+        e = stack.pop()
+        yield e
+        stack.extend(ast.children(e))
+
+
+class Engine:
+    """Evaluates one checked spec over time."""
+
+    def __init__(self, spec: CheckedSpec, now: float) -> None:
+        self.spec = spec
+        self.store = Store(now)
+        self.field_errors: Dict[Tuple[str, str], str] = {}
+        compiler = Compiler(self.store)
+        self._keys = [r.key for r in spec.rules]
+        self._index = {k: i for i, k in enumerate(self._keys)}
+        self._rules = [compiler.compile(r.expr) for r in spec.rules]
+        self._behaviours = [_Behaviour(b, compiler.compile(b.cond)) for b in spec.behaviours]
+        self._paths = {t: tuple(sorted(u.paths, key=str)) for t, u in spec.topics.items()}
+        self._heap: List[Tuple[float, int, int]] = []  # (due, kind 0 rule / 1 behaviour, index)
+        windows: Dict[str, float] = {}
+        direct: List[Tuple[Set[str], Set[str], bool]] = []
+        for expr in [r.expr for r in spec.rules] + [b.cond for b in spec.behaviours]:
+            topics, nodes, timed = set(), set(), False
+            for e in _walk(expr):
+                if isinstance(e, ast.TopicRef):
+                    topics.add(e.topic)
+                elif isinstance(e, ast.NodeRef):
+                    nodes.add(e.node)
+                elif isinstance(e, ast.Call) and e.func in ("age", "frequency"):
+                    timed = True
+                    if e.func == "frequency":
+                        w = e.args[1].value if len(e.args) > 1 else 1.0  # type: ignore[union-attr]
+                        t = e.args[0].topic  # type: ignore[union-attr]
+                        windows[t] = max(windows.get(t, 0.0), float(w))  # type: ignore[arg-type]
+            direct.append((topics, nodes, timed))
+        for topic in spec.topics:
+            self.store.watch(topic, now, windows.get(topic, 0.0))
+        self._windows = windows
+        self._users = self._rule_users(spec)
+        n = len(self._rules)
+        self._topic_plans = {t: self._plan([i for i, d in enumerate(direct) if t in d[0]]) for t in spec.topics}
+        self._node_plans = {nd: self._plan([i for i, d in enumerate(direct) if nd in d[1]]) for nd in spec.nodes}
+        self._tick_plan = self._plan([i for i, d in enumerate(direct) if d[2]])
+        self._rule_plans = [self._plan([i]) for i in range(n)]
+        self._all = self._plan(list(range(n + len(self._behaviours))))
+
+    # -- planning ------------------------------------------------------------------------
+    def _rule_users(self, spec: CheckedSpec) -> List[Set[int]]:
+        users: List[Set[int]] = [set() for _ in spec.rules]
+        n = len(spec.rules)
+        for i, r in enumerate(spec.rules):
+            for dep in r.rule_deps:
+                users[self._index[dep]].add(i)
+        for j, b in enumerate(spec.behaviours):
+            for e in _walk(b.cond):
+                if isinstance(e, ast.RuleRef):
+                    users[self._index[e.key]].add(n + j)
+        return users
+
+    def _plan(self, seeds: List[int]) -> _Plan:
+        """Seeds (rule indices, then n + behaviour index) and everything that uses them."""
+        n = len(self._rules)
+        seen: Set[int] = set()
+        stack = list(seeds)
+        while stack:
+            i = stack.pop()
+            if i in seen:
+                continue
+            seen.add(i)
+            if i < n:
+                stack.extend(self._users[i])
+        return _Plan(tuple(sorted(i for i in seen if i < n)), tuple(sorted(i - n for i in seen if i >= n)))
+
+    # -- inputs --------------------------------------------------------------------------
+    def on_message(self, topic: str, now: float, msg: Any = None) -> List[Event]:
+        """A message on a watched topic; msg None when only its arrival matters."""
+        events = self.advance(now)
+        self.store.arrive(topic, now)
+        for path in self._paths.get(topic, ()):
+            try:
+                value = extract(msg, path)
+                self.field_errors.pop((topic, str(path)), None)
+            except FieldError as exc:
+                value = UNKNOWN
+                self.field_errors[(topic, str(path))] = str(exc)
+            self.store.fields[(topic, path)] = value
+        plan = self._topic_plans.get(topic)
+        if plan is not None:
+            self._run(plan, events)
+        return events
+
+    def on_node_sample(self, node: str, now: float, alive: Any, cpu: Any = UNKNOWN, memory: Any = UNKNOWN) -> List[Event]:
+        """A sample of a node: alive True/False/UNKNOWN, cpu share of a core, memory bytes."""
+        events = self.advance(now)
+        self.store.nodes[node] = {"alive": alive, "cpu": cpu, "memory": memory}
+        plan = self._node_plans.get(node)
+        if plan is not None:
+            self._run(plan, events)
+        return events
+
+    def on_tick(self, now: float) -> List[Event]:
+        """A scheduler tick: time-dependent rules (age, frequency), then `hold` of every active behaviour."""
+        events = self.advance(now)
+        self._run(self._tick_plan, events)
+        for j, b in enumerate(self._behaviours):
+            if b.active:
+                events.append(Event(now, "hold", j + 1, actions=b.actions, line=b.checked.span.line))
+        return events
+
+    def evaluate_all(self, now: float) -> List[Event]:
+        """Evaluate every rule and behaviour (at start, and after a reload)."""
+        events = self.advance(now)
+        self._run(self._all, events)
+        return events
+
+    def advance(self, now: float) -> List[Event]:
+        """Fire every deadline up to `now`, each at its own instant."""
+        events: List[Event] = []
+        while self.next_deadline() is not None and self._heap[0][0] <= now:
+            due, kind, idx = heapq.heappop(self._heap)
+            while self._heap and self._heap[0] == (due, kind, idx):
+                heapq.heappop(self._heap)
+            self.store.now = max(self.store.now, due)
+            if kind == 0:
+                self._run(self._rule_plans[idx], events)
+            else:
+                self._run(_Plan((), (idx,)), events)
+        self.store.now = max(self.store.now, now)
+        return events
+
+    def next_deadline(self) -> Optional[float]:
+        """The instant a `for` timer next turns true by itself (stale entries are dropped)."""
+        while self._heap:
+            due, kind, idx = self._heap[0]
+            compiled = self._rules[idx] if kind == 0 else self._behaviours[idx].compiled
+            if any(t.deadline(self.store.now) == due for t in compiled.timers):
+                return due
+            heapq.heappop(self._heap)  # its timer restarted since: nothing happens then
+        return None
+
+    def reset(self, now: float) -> List[Event]:
+        """Release latched behaviours whose condition is no longer true."""
+        events = self.advance(now)
+        for j, b in enumerate(self._behaviours):
+            if b.active and b.value is not True:
+                b.active = False
+                events.append(Event(now, "release", j + 1, actions=b.actions, line=b.checked.span.line))
+        return events
+
+    # -- state ---------------------------------------------------------------------------
+    def rule_value(self, key: str) -> Any:
+        return self.store.rules.get(key, UNKNOWN)
+
+    def active_behaviours(self) -> List[int]:
+        return [j + 1 for j, b in enumerate(self._behaviours) if b.active]
+
+    # -- evaluation ----------------------------------------------------------------------
+    def _run(self, plan: _Plan, events: List[Event]) -> None:
+        store, now = self.store, self.store.now
+        for i in plan.rules:
+            compiled = self._rules[i]
+            value = compiled.fn()
+            key = self._keys[i]
+            old = store.rules.get(key, UNKNOWN)
+            if value is not old and value != old or key not in store.rules:
+                store.rules[key] = value
+                events.append(Event(now, "rule", rule=key, value=None if value is UNKNOWN else value))
+            self._schedule(compiled, 0, i)
+        for j in plan.behaviours:
+            b = self._behaviours[j]
+            b.value = b.compiled.fn()
+            self._schedule(b.compiled, 1, j)
+            if b.value is True and not b.active:
+                b.active = True
+                events.append(Event(now, "start", j + 1, actions=b.actions, line=b.checked.span.line))
+            elif b.value is not True and b.active and not b.checked.latched:
+                b.active = False
+                events.append(Event(now, "release", j + 1, actions=b.actions, line=b.checked.span.line))
+
+    def _schedule(self, compiled: Compiled, kind: int, idx: int) -> None:
+        now = self.store.now
+        for timer in compiled.timers:
+            due = timer.deadline(now)
+            if due is not None:
+                heapq.heappush(self._heap, (due, kind, idx))

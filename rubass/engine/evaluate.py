@@ -1,0 +1,143 @@
+"""Evaluating checked expressions: each AST node becomes a small Python closure once, when
+the engine is built, so a message costs only calls, never a tree walk or an `eval`."""
+from __future__ import annotations
+
+import math
+from typing import Any, Callable, Dict, List, Tuple
+
+from ..lang import ast
+from .store import Store
+from .temporal import ForTimer
+from .values import UNKNOWN, as_bool, as_num, k_and, k_not, k_or
+
+Fn = Callable[[], Any]
+
+
+class Compiled:
+    """A compiled expression: its function and the `for` timers inside it."""
+
+    def __init__(self, fn: Fn, timers: List[ForTimer]) -> None:
+        self.fn, self.timers = fn, timers
+
+
+def _num2(op: Callable[[float, float], Any]) -> Callable[[Any, Any], Any]:
+    def apply(a: Any, b: Any) -> Any:
+        a, b = as_num(a), as_num(b)
+        if a is UNKNOWN or b is UNKNOWN:
+            return UNKNOWN
+        try:
+            r = op(a, b)
+        except ZeroDivisionError:
+            return UNKNOWN
+        return UNKNOWN if isinstance(r, float) and math.isnan(r) else r
+    return apply
+
+
+def _equal(a: Any, b: Any) -> Any:
+    if a is UNKNOWN or b is UNKNOWN or (type(a) is not type(b)):
+        return UNKNOWN
+    return a == b
+
+
+_BINARY: Dict[str, Callable[[Any, Any], Any]] = {
+    "+": _num2(lambda a, b: a + b), "-": _num2(lambda a, b: a - b),
+    "*": _num2(lambda a, b: a * b), "/": _num2(lambda a, b: a / b),
+    "<": _num2(lambda a, b: a < b), "<=": _num2(lambda a, b: a <= b),
+    ">": _num2(lambda a, b: a > b), ">=": _num2(lambda a, b: a >= b),
+    "==": _equal, "!=": lambda a, b: k_not(_equal(a, b)),
+    "and": lambda a, b: k_and(as_bool(a), as_bool(b)), "or": lambda a, b: k_or(as_bool(a), as_bool(b)),
+}
+
+
+def _scalar_fn(name: str) -> Callable[..., Any]:
+    def apply(*args: Any) -> Any:
+        nums = [as_num(a) for a in args]
+        if any(n is UNKNOWN for n in nums):
+            return UNKNOWN
+        if name == "abs":
+            return abs(nums[0])
+        if name == "sqrt":
+            return math.sqrt(nums[0]) if nums[0] >= 0 else UNKNOWN
+        if name == "hypot":
+            return math.hypot(nums[0], nums[1])
+        return min(nums) if name == "min" else max(nums)
+    return apply
+
+
+def _array_fn(name: str, read: Fn) -> Fn:
+    def apply() -> Any:
+        arr = read()
+        if not isinstance(arr, tuple):
+            return UNKNOWN
+        if name == "len":
+            return float(len(arr))
+        valid = [v for v in arr if type(v) is float]  # NaN readings were converted to UNKNOWN
+        if not valid:
+            return UNKNOWN
+        return min(valid) if name == "min" else max(valid)
+    return apply
+
+
+class Compiler:
+    """Turns checked expressions into closures reading one Store."""
+
+    def __init__(self, store: Store) -> None:
+        self.store = store
+
+    def compile(self, expr: ast.Expr) -> Compiled:
+        timers: List[ForTimer] = []
+        return Compiled(self._fn(expr, timers), timers)
+
+    def _fn(self, e: ast.Expr, timers: List[ForTimer]) -> Fn:
+        store = self.store
+        if isinstance(e, ast.Lit):
+            value = e.value
+            return lambda: value
+        if isinstance(e, ast.RuleRef):
+            rules, key = store.rules, e.key
+            return lambda: rules.get(key, UNKNOWN)
+        if isinstance(e, ast.TopicRef):
+            fields, slot = store.fields, (e.topic, e.path)
+            return lambda: fields.get(slot, UNKNOWN)
+        if isinstance(e, ast.Unary):
+            inner = self._fn(e.operand, timers)
+            if e.op == "not":
+                return lambda: k_not(as_bool(inner()))
+            neg = _num2(lambda a, b: a - b)
+            return lambda: neg(0.0, inner())
+        if isinstance(e, ast.Binary):
+            left, right, op = self._fn(e.left, timers), self._fn(e.right, timers), _BINARY[e.op]
+            return lambda: op(left(), right())  # both sides always: their timers must see every evaluation
+        if isinstance(e, ast.For):
+            operand = self._fn(e.operand, timers)
+            assert isinstance(e.duration, ast.Lit) and isinstance(e.duration.value, float)
+            timer = ForTimer(e.duration.value)
+            timers.append(timer)
+            return lambda: timer.update(store.now, as_bool(operand()))
+        if isinstance(e, ast.Call):
+            return self._call(e, timers)
+        raise TypeError(f"cannot evaluate {type(e).__name__}")
+
+    def _call(self, e: ast.Call, timers: List[ForTimer]) -> Fn:
+        store = self.store
+        if e.func == "age":
+            topic = e.args[0].topic  # type: ignore[union-attr]
+            return lambda: store.age(topic)
+        if e.func == "frequency":
+            topic = e.args[0].topic  # type: ignore[union-attr]
+            window = e.args[1].value if len(e.args) > 1 else 1.0  # type: ignore[union-attr]
+            return lambda: store.frequency(topic, window)  # type: ignore[arg-type]
+        if e.func in ("alive", "cpu", "memory"):
+            node, attr = e.args[0].node, e.func  # type: ignore[union-attr]
+            return lambda: store.node_value(node, attr)
+        if e.func in ("min", "max", "len") and len(e.args) == 1:
+            return _array_fn(e.func, self._fn(e.args[0], timers))
+        args: Tuple[Fn, ...] = tuple(self._fn(a, timers) for a in e.args)
+        fn = _scalar_fn(e.func)
+        if len(args) == 1:
+            (a,) = args
+            return lambda: fn(a())
+        if len(args) == 2:
+            a, b = args
+            return lambda: fn(a(), b())
+        return lambda: fn(*[a() for a in args])

@@ -1,0 +1,65 @@
+"""Reading a field path out of a message of any type, without importing ROS.
+
+Works on deserialised rospy messages (attributes), on dicts (tests, YAML traces) and on
+anything shaped like them. Integers become floats, NaN and short arrays become UNKNOWN.
+"""
+from __future__ import annotations
+
+import math
+from typing import Any, Tuple
+
+from ..lang.ast import PathElem
+from .values import UNKNOWN
+
+
+class FieldError(Exception):
+    """A field path that does not exist in the message's type (a spec/type mismatch)."""
+
+
+def path_text(path: Tuple[PathElem, ...]) -> str:
+    return "".join(f"[{p}]" if isinstance(p, int) else f".{p}" for p in path).lstrip(".")
+
+
+def extract(msg: Any, path: Tuple[PathElem, ...]) -> Any:
+    """The value at `path` in `msg`; FieldError when the type has no such field."""
+    value = msg
+    for i, elem in enumerate(path):
+        if isinstance(elem, int):
+            if not isinstance(value, (list, tuple, bytes, bytearray)):
+                raise FieldError(f"'{path_text(path[:i])}' is not an array")
+            if not -len(value) <= elem < len(value):
+                return UNKNOWN  # arrays vary in length: a missing element is missing data
+            value = value[elem]
+            continue
+        if isinstance(value, dict):
+            if elem not in value:
+                raise FieldError(f"no field '{path_text(path[:i + 1])}'")
+            value = value[elem]
+            continue
+        slots = getattr(value, "__slots__", None)
+        if slots is not None and elem not in slots:
+            raise FieldError(f"no field '{path_text(path[:i + 1])}'")
+        try:
+            value = getattr(value, elem)
+        except AttributeError:
+            raise FieldError(f"no field '{path_text(path[:i + 1])}'") from None
+    return convert(value, path)
+
+
+def convert(value: Any, path: Tuple[PathElem, ...] = ()) -> Any:
+    """A message value as an engine value."""
+    if value is True or value is False:
+        return value
+    if isinstance(value, (int, float)):
+        f = float(value)
+        return UNKNOWN if math.isnan(f) else f
+    if isinstance(value, str):
+        return value
+    if isinstance(value, (bytes, bytearray)):
+        return tuple(float(b) for b in value)
+    if isinstance(value, (list, tuple)):
+        return tuple(convert(v, path) for v in value)
+    to_sec = getattr(value, "to_sec", None)  # rospy Time / Duration
+    if callable(to_sec):
+        return float(to_sec())
+    raise FieldError(f"'{path_text(path)}' is a message ({type(value).__name__}), not a value: name one of its fields")

@@ -1,0 +1,63 @@
+"""What the engine knows about the world at one instant: field values, arrivals, node samples,
+rule values, and the current time. Written only by the engine's thread."""
+from __future__ import annotations
+
+import bisect
+from typing import Any, Dict, List, Optional, Tuple
+
+from ..lang.ast import PathElem
+from .values import UNKNOWN
+
+
+class Store:
+    def __init__(self, now: float) -> None:
+        self.now = now
+        self.fields: Dict[Tuple[str, Tuple[PathElem, ...]], Any] = {}
+        self.rules: Dict[str, Any] = {}
+        self.watch_start: Dict[str, float] = {}
+        self.last_arrival: Dict[str, float] = {}
+        self._arrivals: Dict[str, List[float]] = {}
+        self._window: Dict[str, float] = {}
+        self.nodes: Dict[str, Dict[str, Any]] = {}
+
+    def watch(self, topic: str, now: float, window: float = 0.0) -> None:
+        """Start watching a topic (age counts from here); keep arrivals for `window` seconds."""
+        self.watch_start.setdefault(topic, now)
+        self._window[topic] = max(self._window.get(topic, 0.0), window)
+        self._arrivals.setdefault(topic, [])
+
+    def arrive(self, topic: str, now: float) -> None:
+        self.last_arrival[topic] = now
+        window = self._window.get(topic, 0.0)
+        if window > 0.0:
+            arr = self._arrivals[topic]
+            arr.append(now)
+            if len(arr) > 64 and arr[len(arr) // 2] < now - window:  # drop the old half at once
+                del arr[: bisect.bisect_left(arr, now - window)]
+
+    def age(self, topic: str) -> Any:
+        last = self.last_arrival.get(topic, self.watch_start.get(topic))
+        return UNKNOWN if last is None else max(0.0, self.now - last)
+
+    def frequency(self, topic: str, window: float) -> Any:
+        start = self.watch_start.get(topic)
+        if start is None or self.now - start < window:
+            return UNKNOWN
+        arr = self._arrivals.get(topic, [])
+        lo = bisect.bisect_right(arr, self.now - window)
+        hi = bisect.bisect_right(arr, self.now)
+        return (hi - lo) / window
+
+    def next_frequency_change(self, topic: str, window: float) -> Optional[float]:
+        """The next instant frequency(topic, window) changes without a new message."""
+        start = self.watch_start.get(topic)
+        if start is None:
+            return None
+        if self.now - start < window:
+            return start + window
+        arr = self._arrivals.get(topic, [])
+        lo = bisect.bisect_right(arr, self.now - window)
+        return arr[lo] + window if lo < len(arr) else None
+
+    def node_value(self, node: str, attr: str) -> Any:
+        return self.nodes.get(node, {}).get(attr, UNKNOWN)

@@ -1,0 +1,86 @@
+"""The engine with a manual clock: exact `for`, unknowns, latching and reset, locality."""
+import os
+
+from rubass.engine import UNKNOWN, Engine
+from rubass.lang import check_text
+
+from conftest import ROOT
+
+LIB = os.path.join(ROOT, "docs", "examples", "actions.yaml")
+
+
+def engine(body, now=0.0):
+    spec = check_text("action primitive stop, warn;\n" + body, os.path.join(ROOT, "x.rbs"), [LIB])
+    e = Engine(spec, now)
+    e.evaluate_all(now)
+    return e
+
+
+def starts(events):
+    return [(round(ev.time, 9), ev.behaviour) for ev in events if ev.kind == "start"]
+
+
+def test_fig2_fires_at_exactly_t0_plus_both_durations():
+    text = open(os.path.join(ROOT, "config", "fig2.rbs")).read()
+    e = Engine(check_text(text, os.path.join(ROOT, "config", "fig2.rbs"), [LIB]), 0.0)
+    e.evaluate_all(0.0)
+    e.on_message("/cmd_vel_left", 1.0, {"linear": {"x": 0.5}})
+    e.on_message("/encoder_left", 1.0, {"data": 0})
+    assert e.next_deadline() == 1.4
+    assert e.advance(1.4)[-1].value is True
+    assert e.next_deadline() == 2.4
+    assert starts(e.advance(10.0)) == [(2.4, 1)]
+
+
+def test_any_false_evaluation_restarts_for():
+    e = engine("entity a { rules: r: (topic /x.data > 1) for 1 s; }\nif (a.r) then { warn; }\n")
+    e.on_message("/x", 0.0, {"data": 2})
+    e.on_message("/x", 0.5, {"data": 0})
+    e.on_message("/x", 0.6, {"data": 2})
+    assert e.next_deadline() == 1.6
+    assert starts(e.advance(1.59)) == []
+    assert starts(e.advance(1.6)) == [(1.6, 1)]
+
+
+def test_unknown_never_fires_and_nan_is_unknown():
+    e = engine("entity a { rules: r: topic /x.data > 1 or topic /y.data > 1; }\nif (a.r) then { warn; }\n")
+    assert e.rule_value("a.r") is UNKNOWN
+    e.on_message("/x", 0.1, {"data": float("nan")})
+    assert e.rule_value("a.r") is UNKNOWN
+    e.on_message("/y", 0.2, {"data": 3})
+    assert e.rule_value("a.r") is True  # true or unknown = true
+
+
+def test_latched_behaviour_holds_until_reset_after_cause_is_gone():
+    e = engine("entity a { rules: r: topic /x.data > 1; }\nif (a.r) then { stop; }\n")
+    assert starts(e.on_message("/x", 1.0, {"data": 5})) == [(1.0, 1)]
+    assert e.reset(1.5) == []  # cause still there: reset does nothing
+    assert [ev.kind for ev in e.on_message("/x", 2.0, {"data": 0}) if ev.kind != "rule"] == []
+    assert [ev.kind for ev in e.on_tick(2.1) if ev.kind != "rule"] == ["hold"]
+    assert [(ev.kind, ev.behaviour) for ev in e.reset(3.0)] == [("release", 1)]
+
+
+def test_non_latched_behaviour_releases():
+    e = engine("entity a { rules: r: topic /x.data > 1; }\nif (a.r) then { warn; }\n")
+    e.on_message("/x", 1.0, {"data": 5})
+    assert [ev.kind for ev in e.on_message("/x", 2.0, {"data": 0}) if ev.kind != "rule"] == ["release"]
+
+
+def test_age_counts_from_watch_start_and_fires_on_tick():
+    e = engine("entity a { rules: silent: age(topic /odom) > 0.5 s; }\nif (a.silent) then { warn; }\n", now=10.0)
+    assert starts(e.on_tick(10.4)) == []
+    assert starts(e.on_tick(10.6)) == [(10.6, 1)]
+
+
+def test_missing_field_is_an_error_and_unknown():
+    e = engine("entity a { rules: r: topic /x.dtaa > 1; }\nif (a.r) then { warn; }\n")
+    e.on_message("/x", 1.0, {"data": 5})
+    assert e.rule_value("a.r") is UNKNOWN
+    assert e.field_errors == {("/x", "('dtaa',)"): "no field 'dtaa'"}
+
+
+def test_a_message_reevaluates_only_its_dependents():
+    body = "".join(f"entity e{i} {{ rules: r: topic /t{i}.data > 1; }}\n" for i in range(50))
+    e = engine(body + "if (e0.r) then { warn; }\n")
+    events = e.on_message("/t7", 1.0, {"data": 5})
+    assert [ev.rule for ev in events] == ["e7.r"]
