@@ -185,9 +185,9 @@ class Engine:
         while self._heap:
             due, kind, idx = self._heap[0]
             compiled = self._rules[idx] if kind == 0 else self._behaviours[idx].compiled
-            if any(t.deadline(self.store.now) == due for t in compiled.timers):
+            if due in compiled.deadlines(self.store):
                 return due
-            heapq.heappop(self._heap)  # its timer restarted since: nothing happens then
+            heapq.heappop(self._heap)  # its cause changed since: nothing happens then
         return None
 
     def reset(self, now: float) -> List[Event]:
@@ -230,8 +230,5 @@ class Engine:
                 events.append(Event(now, "release", j + 1, actions=b.actions, line=b.checked.span.line))
 
     def _schedule(self, compiled: Compiled, kind: int, idx: int) -> None:
-        now = self.store.now
-        for timer in compiled.timers:
-            due = timer.deadline(now)
-            if due is not None:
-                heapq.heappush(self._heap, (due, kind, idx))
+        for due in compiled.deadlines(self.store):
+            heapq.heappush(self._heap, (due, kind, idx))

@@ -13,11 +13,33 @@ from .values import UNKNOWN, as_bool, as_num, k_and, k_not, k_or
 Fn = Callable[[], Any]
 
 
-class Compiled:
-    """A compiled expression: its function and the `for` timers inside it."""
+# Deadlines for age and frequency are set this much after the exact crossing, so that the
+# evaluation there sees the new value despite float rounding (ROS wall-clock times near
+# 1.7e9 s have a resolution of 2.4e-7 s).
+CROSSING_MARGIN = 1e-6
 
-    def __init__(self, fn: Fn, timers: List[ForTimer]) -> None:
-        self.fn, self.timers = fn, timers
+
+class Compiled:
+    """A compiled condition: its function, its `for` timers, and the age/frequency uses
+    whose values change by themselves with time (so that they get deadlines too)."""
+
+    def __init__(self, fn: Fn, timers: List[ForTimer], ages: List[Tuple[str, float]],
+                 freqs: List[Tuple[str, float]]) -> None:
+        self.fn, self.timers, self.ages, self.freqs = fn, timers, ages, freqs
+
+    def deadlines(self, store: Store) -> List[float]:
+        """The future instants at which this condition may change with no new input."""
+        now = store.now
+        out = [d for d in (t.deadline(now) for t in self.timers) if d is not None]
+        for topic, limit in self.ages:
+            base = store.last_arrival.get(topic, store.watch_start.get(topic))
+            if base is not None and base + limit + CROSSING_MARGIN > now:
+                out.append(base + limit + CROSSING_MARGIN)
+        for topic, window in self.freqs:
+            change = store.next_frequency_change(topic, window)
+            if change is not None and change + CROSSING_MARGIN > now:
+                out.append(change + CROSSING_MARGIN)
+        return out
 
 
 def _num2(op: Callable[[float, float], Any]) -> Callable[[Any, Any], Any]:
@@ -85,8 +107,24 @@ class Compiler:
         self.store = store
 
     def compile(self, expr: ast.Expr) -> Compiled:
+        """A condition: its value is always True, False or UNKNOWN."""
         timers: List[ForTimer] = []
-        return Compiled(self._fn(expr, timers), timers)
+        inner = self._fn(expr, timers)
+        ages: List[Tuple[str, float]] = []
+        freqs: List[Tuple[str, float]] = []
+        stack = [expr]
+        while stack:
+            e = stack.pop()
+            stack.extend(ast.children(e))
+            if isinstance(e, ast.Call) and e.func == "frequency":
+                window = e.args[1].value if len(e.args) > 1 else 1.0  # type: ignore[union-attr]
+                freqs.append((e.args[0].topic, float(window)))  # type: ignore[union-attr,arg-type]
+            if isinstance(e, ast.Binary) and e.op in ("<", "<=", ">", ">="):
+                for a, b in ((e.left, e.right), (e.right, e.left)):
+                    if isinstance(a, ast.Call) and a.func == "age" and isinstance(b, ast.Lit) \
+                            and isinstance(b.value, float):
+                        ages.append((a.args[0].topic, b.value))  # type: ignore[union-attr]
+        return Compiled(lambda: as_bool(inner()), timers, ages, freqs)
 
     def _fn(self, e: ast.Expr, timers: List[ForTimer]) -> Fn:
         store = self.store

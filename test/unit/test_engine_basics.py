@@ -66,10 +66,11 @@ def test_non_latched_behaviour_releases():
     assert [ev.kind for ev in e.on_message("/x", 2.0, {"data": 0}) if ev.kind != "rule"] == ["release"]
 
 
-def test_age_counts_from_watch_start_and_fires_on_tick():
+def test_age_counts_from_watch_start_and_fires_at_its_crossing_not_the_next_tick():
     e = engine("entity a { rules: silent: age(topic /odom) > 0.5 s; }\nif (a.silent) then { warn; }\n", now=10.0)
     assert starts(e.on_tick(10.4)) == []
-    assert starts(e.on_tick(10.6)) == [(10.6, 1)]
+    assert e.next_deadline() == 10.5 + 1e-6
+    assert starts(e.on_tick(10.6)) == [(10.500001, 1)]
 
 
 def test_missing_field_is_an_error_and_unknown():
