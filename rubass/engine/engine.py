@@ -126,7 +126,29 @@ class Engine:
     # -- inputs --------------------------------------------------------------------------
     def on_message(self, topic: str, now: float, msg: Any = None) -> List[Event]:
         """A message on a watched topic; msg None when only its arrival matters."""
-        events = self.advance(now)
+        return self.on_messages(now, ((topic, msg),))
+
+    def on_messages(self, now: float, items: Iterable[Tuple[str, Any]]) -> List[Event]:
+        """Messages that share one instant (as in a recording): one evaluation after all of them.
+
+        Evaluating between them would see a state that never existed at any instant (one
+        topic updated, the other not yet) and could restart a `for`.
+        """
+        events = self.advance(now, inclusive=False)
+        rules: Set[int] = set()
+        behaviours: Set[int] = set()
+        for topic, msg in items:
+            self._store_message(topic, now, msg)
+            plan = self._topic_plans.get(topic)
+            if plan is not None:
+                rules.update(plan.rules)
+                behaviours.update(plan.behaviours)
+        if rules or behaviours:
+            self._run(_Plan(tuple(sorted(rules)), tuple(sorted(behaviours))), events)
+        events += self.advance(now)
+        return events
+
+    def _store_message(self, topic: str, now: float, msg: Any) -> None:
         self.store.arrive(topic, now)
         for path in self._paths.get(topic, ()):
             try:
@@ -136,18 +158,15 @@ class Engine:
                 value = UNKNOWN
                 self.field_errors[(topic, str(path))] = str(exc)
             self.store.fields[(topic, path)] = value
-        plan = self._topic_plans.get(topic)
-        if plan is not None:
-            self._run(plan, events)
-        return events
 
     def on_node_sample(self, node: str, now: float, alive: Any, cpu: Any = UNKNOWN, memory: Any = UNKNOWN) -> List[Event]:
         """A sample of a node: alive True/False/UNKNOWN, cpu share of a core, memory bytes."""
-        events = self.advance(now)
+        events = self.advance(now, inclusive=False)
         self.store.nodes[node] = {"alive": alive, "cpu": cpu, "memory": memory}
         plan = self._node_plans.get(node)
         if plan is not None:
             self._run(plan, events)
+        events += self.advance(now)
         return events
 
     def on_tick(self, now: float) -> List[Event]:
@@ -165,10 +184,15 @@ class Engine:
         self._run(self._all, events)
         return events
 
-    def advance(self, now: float) -> List[Event]:
-        """Fire every deadline up to `now`, each at its own instant."""
+    def advance(self, now: float, inclusive: bool = True) -> List[Event]:
+        """Fire every deadline up to `now` (before it, if not inclusive), each at its own instant.
+
+        Inputs call this non-inclusively first: new data at t is the evaluation at t, so a
+        `for` that a message at t falsifies never fires at t with the old data.
+        """
         events: List[Event] = []
-        while self.next_deadline() is not None and self._heap[0][0] <= now:
+        while self.next_deadline() is not None and (
+                self._heap[0][0] <= now if inclusive else self._heap[0][0] < now):
             due, kind, idx = heapq.heappop(self._heap)
             while self._heap and self._heap[0] == (due, kind, idx):
                 heapq.heappop(self._heap)
@@ -185,7 +209,7 @@ class Engine:
         while self._heap:
             due, kind, idx = self._heap[0]
             compiled = self._rules[idx] if kind == 0 else self._behaviours[idx].compiled
-            if due in compiled.deadlines(self.store):
+            if due in compiled.deadlines(self.store, strict=False):
                 return due
             heapq.heappop(self._heap)  # its cause changed since: nothing happens then
         return None

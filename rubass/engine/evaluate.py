@@ -27,17 +27,22 @@ class Compiled:
                  freqs: List[Tuple[str, float]]) -> None:
         self.fn, self.timers, self.ages, self.freqs = fn, timers, ages, freqs
 
-    def deadlines(self, store: Store) -> List[float]:
-        """The future instants at which this condition may change with no new input."""
+    def deadlines(self, store: Store, strict: bool = True) -> List[float]:
+        """The instants after now (or at now, if not strict) at which this condition may
+        change with no new input."""
         now = store.now
-        out = [d for d in (t.deadline(now) for t in self.timers) if d is not None]
+
+        def ahead(t: float) -> bool:
+            return t > now if strict else t >= now
+
+        out = [d for d in (t.deadline(now, strict) for t in self.timers) if d is not None]
         for topic, limit in self.ages:
             base = store.last_arrival.get(topic, store.watch_start.get(topic))
-            if base is not None and base + limit + CROSSING_MARGIN > now:
+            if base is not None and ahead(base + limit + CROSSING_MARGIN):
                 out.append(base + limit + CROSSING_MARGIN)
         for topic, window in self.freqs:
             change = store.next_frequency_change(topic, window)
-            if change is not None and change + CROSSING_MARGIN > now:
+            if change is not None and ahead(change + CROSSING_MARGIN):
                 out.append(change + CROSSING_MARGIN)
         return out
 

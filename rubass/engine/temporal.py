@@ -28,12 +28,12 @@ class ForTimer:
         self.since = None
         return UNKNOWN if value is UNKNOWN else False
 
-    def deadline(self, now: float) -> Optional[float]:
-        """When this timer will turn true if nothing changes, or None."""
+    def deadline(self, now: float, strict: bool = True) -> Optional[float]:
+        """When this timer turns true if nothing changes: after now (strict) or at now, or None."""
         if self.since is None:
             return None
         due = self.since + self.duration
-        return due if due > now else None
+        return due if (due > now if strict else due >= now) else None
 
     def reset(self) -> None:
         self.since = None
