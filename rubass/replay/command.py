@@ -1,0 +1,119 @@
+"""`rubass replay SPEC BAG [--json] [--plot FILE.png] [--actions LIB.yaml] [--rate HZ]`."""
+from __future__ import annotations
+
+import argparse
+import sys
+from typing import Dict, List, Set, Tuple
+
+from ..lang import SpecError, ast, load_spec
+from ..lang.model import CheckedSpec
+from . import report
+
+
+def register(sub: "argparse._SubParsersAction[argparse.ArgumentParser]") -> None:
+    p = sub.add_parser("replay", help="run a spec over a ROS 1 recording (no master needed)",
+                       description="Evaluate SPEC over the messages of BAG at their recorded times, "
+                                   "with ticks at the monitor's rate in between.")
+    p.add_argument("spec", metavar="SPEC")
+    p.add_argument("bag", metavar="BAG")
+    p.add_argument("--json", action="store_true", help="print one JSON object per line (docs/replay.md)")
+    p.add_argument("--plot", metavar="FILE.png", help="write a timeline picture")
+    p.add_argument("--actions", action="append", default=[], metavar="LIB.yaml",
+                   help="an action library to load besides the spec's imports (repeatable)")
+    p.add_argument("--rate", type=_rate, default=50.0, metavar="HZ", help="tick rate (default 50)")
+    p.set_defaults(func=run)
+
+
+def _rate(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"'{text}' is not a number of Hz") from None
+    if not 0.1 <= value <= 10000:
+        raise argparse.ArgumentTypeError(f"{value} Hz is out of range (0.1 to 10000)")
+    return value
+
+
+def _global(name: str) -> str:
+    return name if name.startswith("/") else "/" + name.lstrip("~")
+
+
+def _field_uses(spec: CheckedSpec) -> Dict[Tuple[str, Tuple[ast.PathElem, ...]], List[str]]:
+    """(topic, path) -> the rules (or behaviours) that read it."""
+    uses: Dict[Tuple[str, Tuple[ast.PathElem, ...]], List[str]] = {}
+    owners = [(f"rule '{r.key}'", r.expr) for r in spec.rules] + \
+             [(f"behaviour {b.index} (line {b.span.line})", b.cond) for b in spec.behaviours]
+    for owner, expr in owners:
+        stack = [expr]
+        while stack:
+            e = stack.pop()
+            stack.extend(ast.children(e))
+            if isinstance(e, ast.TopicRef) and e.path:
+                users = uses.setdefault((e.topic, e.path), [])
+                if owner not in users:
+                    users.append(owner)
+    return uses
+
+
+def run(args: argparse.Namespace) -> int:
+    try:
+        spec = load_spec(args.spec, args.actions)
+    except SpecError as exc:
+        print(exc.render(), file=sys.stderr)
+        return 1
+    from ..ros.bag import BagError, message_classes, open_bag, read
+    from ..ros.msgtypes import check_path
+
+    try:
+        bag, info = open_bag(args.bag)
+    except BagError as exc:
+        print(f"rubass replay: error: {exc}", file=sys.stderr)
+        return 1
+    with bag:
+        topic_map = {_global(t): t for t in spec.topics}  # bag name -> spec name
+        for name in sorted(topic_map):
+            if name not in info.types:
+                print(f"rubass replay: warning: topic {name} is not in {args.bag}; its values stay unknown",
+                      file=sys.stderr)
+        if spec.nodes:
+            print("rubass replay: warning: a recording has no node samples; alive(), cpu() and memory() "
+                  "stay unknown", file=sys.stderr)
+        present = [t for t in topic_map if t in info.types]
+        decode: Set[str] = {t for t in present if spec.topics[topic_map[t]].needs_data}
+        classes = message_classes(bag, sorted(decode))
+        errors = []
+        for (topic, path), owners in sorted(_field_uses(spec).items(), key=str):
+            cls = classes.get(_global(topic))
+            problem = check_path(cls, path) if cls is not None else None
+            if problem:
+                field = "".join(f"[{p}]" if isinstance(p, int) else f".{p}" for p in path)
+                errors.append(f"rubass replay: error: {' and '.join(owners)} reads {topic}{field}, but in "
+                              f"{info.types[_global(topic)]}: {problem}")
+        if errors:
+            print("\n".join(errors), file=sys.stderr)
+            return 1
+        from .run import replay
+
+        stream = ((t, topic_map[topic], msg) for t, topic, msg in read(bag, present, decode))
+        try:
+            _, events = replay(spec, stream, info.start, info.end, args.rate)
+        except BagError as exc:
+            print(f"rubass replay: error: {exc}", file=sys.stderr)
+            return 1
+    duration = info.end - info.start
+    if args.json:
+        report.json_lines(events, sys.stdout)
+    else:
+        print(f"replay of {args.spec} over {args.bag}: {duration:.3f} s, {info.messages} messages")
+        report.human(spec, events, duration, sys.stdout)
+    if args.plot:
+        from .plot import plot
+
+        try:
+            plot(spec, events, duration, args.plot, title=f"{args.spec} over {args.bag}")
+        except OSError as exc:
+            print(f"rubass replay: error: cannot write {args.plot}: {exc.strerror or exc}", file=sys.stderr)
+            return 1
+        if not args.json:
+            print(f"timeline written to {args.plot}")
+    return 0

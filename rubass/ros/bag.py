@@ -1,0 +1,69 @@
+"""Reading ROS 1 recordings for replay: messages in time order, deserialised only where needed."""
+from __future__ import annotations
+
+import os
+from dataclasses import dataclass
+from typing import Any, Dict, Iterator, List, Optional, Set, Tuple
+
+import rosbag
+
+
+class BagError(Exception):
+    """A recording that cannot be read; the message says why, in one line."""
+
+
+@dataclass
+class BagInfo:
+    path: str
+    start: float
+    end: float
+    messages: int
+    types: Dict[str, str]  # topic -> message type
+
+
+def open_bag(path: str) -> Tuple["rosbag.Bag", BagInfo]:
+    """Open a bag for reading; BagError for a missing, unreadable, unindexed or corrupt file."""
+    if not os.path.exists(path):
+        raise BagError(f"{path}: no such file")
+    if os.path.isdir(path):
+        raise BagError(f"{path}: is a directory, not a bag")
+    try:
+        bag = rosbag.Bag(path, "r")
+        info = bag.get_type_and_topic_info()
+        types = {t: v.msg_type for t, v in info.topics.items()}
+        count = sum(v.message_count for v in info.topics.values())
+        start = bag.get_start_time() if count else 0.0
+        end = bag.get_end_time() if count else 0.0
+    except rosbag.ROSBagUnindexedException:
+        raise BagError(f"{path}: the bag is not indexed (was recording interrupted?): "
+                       f"run 'rosbag reindex {path}'") from None
+    except (rosbag.ROSBagException, OSError, ValueError, KeyError, EOFError) as exc:
+        raise BagError(f"{path}: not a readable ROS 1 bag ({exc.__class__.__name__}: {exc})") from None
+    return bag, BagInfo(path, start, end, count, types)
+
+
+def message_classes(bag: "rosbag.Bag", topics: List[str]) -> Dict[str, Any]:
+    """The message class of each topic (from the first message, so unknown types work too)."""
+    out: Dict[str, Any] = {}
+    for topic in topics:
+        for _, raw, _ in bag.read_messages(topics=[topic], raw=True):
+            out[topic] = raw[-1]
+            break
+    return out
+
+
+def read(bag: "rosbag.Bag", topics: List[str], decode: Set[str]) -> Iterator[Tuple[float, str, Optional[Any]]]:
+    """(time, topic, message or None) in recorded order; only topics in `decode` are deserialised."""
+    if not topics:
+        return  # rosbag reads every topic when given none
+    try:
+        for topic, raw, stamp in bag.read_messages(topics=topics, raw=True):
+            msg = None
+            if topic in decode:
+                msg = raw[-1]()
+                msg.deserialize(raw[1])
+            yield stamp.to_sec(), topic, msg
+    except (rosbag.ROSBagException, OSError, ValueError, KeyError, EOFError) as exc:
+        raise BagError(f"{bag.filename}: the bag is corrupt ({exc.__class__.__name__}: {exc})") from None
+    except Exception as exc:  # genpy.DeserializationError and struct.error from a damaged chunk
+        raise BagError(f"{bag.filename}: a message cannot be read ({exc.__class__.__name__}: {exc})") from None

@@ -1,0 +1,65 @@
+"""Checking a spec's field paths against a ROS message class (genpy, static or dynamic)."""
+from __future__ import annotations
+
+import re
+import sys
+from typing import Any, Optional, Tuple
+
+from ..lang.ast import PathElem
+
+_ARRAY = re.compile(r"(.*)\[(\d*)\]$")
+_PRIMITIVES = {"bool", "int8", "uint8", "int16", "uint16", "int32", "uint32", "int64", "uint64",
+               "float32", "float64", "string", "time", "duration", "char", "byte"}
+
+
+def _message_class(type_name: str, near: Any) -> Optional[Any]:
+    """The class of a nested message type, looked up beside `near` (dynamic types) or installed."""
+    if type_name == "Header":
+        type_name = "std_msgs/Header"
+    if "/" not in type_name:
+        return None
+    pkg, name = type_name.split("/", 1)
+    found = getattr(sys.modules.get(near.__module__), f"_{pkg}__{name}", None)
+    if found is not None:
+        return found
+    try:
+        import genpy.message
+
+        return genpy.message.get_message_class(type_name)
+    except Exception:  # not installed here: the path cannot be checked further
+        return None
+
+
+def check_path(cls: Any, path: Tuple[PathElem, ...]) -> Optional[str]:
+    """None if `path` can exist in messages of class `cls`, else what is wrong with it."""
+    type_name = getattr(cls, "_type", cls.__name__)
+    current: Optional[Any] = cls
+    slot_type = type_name
+    done = ""
+    for elem in path:
+        m = _ARRAY.match(slot_type)
+        if isinstance(elem, int):
+            if not m:
+                return f"'{done or type_name}' is not an array (it is {slot_type})"
+            slot_type = m.group(1)
+            current = None if slot_type in _PRIMITIVES else _message_class(slot_type, cls)
+            done += f"[{elem}]"
+            continue
+        if m:
+            return f"'{done}' is an array ({slot_type}): index it, e.g. '{done}[0].{elem}'"
+        if slot_type in _PRIMITIVES:
+            return f"'{done}' is a {slot_type}, it has no field '{elem}'"
+        if current is None:
+            return None  # a type we cannot see into: accept
+        slots = list(getattr(current, "__slots__", ()))
+        if elem not in slots:
+            where = f"'{done}' ({slot_type})" if done else type_name
+            return f"{where} has no field '{elem}' (fields: {', '.join(slots)})"
+        slot_type = current._slot_types[slots.index(elem)]
+        done = f"{done}.{elem}" if done else elem
+        am = _ARRAY.match(slot_type)
+        base = am.group(1) if am else slot_type
+        current = None if base in _PRIMITIVES else _message_class(base, cls)
+    if not _ARRAY.match(slot_type) and slot_type not in _PRIMITIVES:
+        return f"'{done}' is a message ({slot_type}), not a value: name one of its fields"
+    return None

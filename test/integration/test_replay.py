@@ -1,0 +1,154 @@
+"""`rubass replay` on bags the tests write with the rosbag API, and on a real recording."""
+import json
+import os
+import subprocess
+import sys
+
+import pytest
+
+rosbag = pytest.importorskip("rosbag")
+import rospy  # noqa: E402
+from geometry_msgs.msg import Twist  # noqa: E402
+from std_msgs.msg import Float64, String  # noqa: E402
+
+from conftest import ROOT, shared_path  # noqa: E402
+
+pytestmark = pytest.mark.ros
+LIB = os.path.join(ROOT, "docs", "examples", "actions.yaml")
+T0 = 1700000000.0  # wall-clock-like stamps, as real bags have
+
+
+def write_bag(path, items):
+    """items: (seconds since T0, topic, message)."""
+    with rosbag.Bag(path, "w") as bag:
+        for t, topic, msg in items:
+            bag.write(topic, msg, rospy.Time.from_sec(T0 + t))
+    return path
+
+
+def twist(x):
+    m = Twist()
+    m.linear.x = x
+    return m
+
+
+def spec_file(write, body):
+    return write("s.rbs", f'import "{LIB}";\naction primitive stop, warn;\n' + body)
+
+
+def replay(*args):
+    proc = subprocess.run([sys.executable, "-m", "rubass", "replay", *args], cwd=ROOT, capture_output=True,
+                          text=True, timeout=300)
+    assert "Traceback" not in proc.stderr, proc.stderr
+    return proc
+
+
+SPEED = ("entity base { rules: fast: (topic /cmd_vel.linear.x > 1.0 m/s) for 0.5 s; }\n"
+         "if (base.fast) then { stop; }\n")
+
+
+def test_json_events_at_recorded_times(write, tmp_path):
+    bag = write_bag(str(tmp_path / "b.bag"), [(0.0, "/cmd_vel", twist(0.2)), (1.0, "/cmd_vel", twist(1.5)),
+                                              (1.2, "/cmd_vel", twist(1.6)), (3.0, "/cmd_vel", twist(0.0))])
+    proc = replay(spec_file(write, SPEED), bag, "--json")
+    assert proc.returncode == 0, proc.stderr
+    lines = [json.loads(line) for line in proc.stdout.splitlines()]
+    starts = [x for x in lines if x["event"] == "start"]
+    assert len(starts) == 1 and starts[0]["time"] == pytest.approx(1.5, abs=1e-6)
+    assert starts[0] == {"time": starts[0]["time"], "event": "start", "behaviour": 1, "line": 4, "actions": ["stop"]}
+    rule = [(x["time"], x["value"]) for x in lines if x["event"] == "rule"]
+    assert [v for _, v in rule] == [None, False, True, False]
+    assert [round(t, 6) for t, _ in rule] == [0.0, 0.0, 1.5, 3.0]
+    assert [x["time"] for x in lines] == sorted(x["time"] for x in lines)
+    assert not [x for x in lines if x["event"] == "release"]  # the stop is latched
+
+
+def test_human_report_and_plot(write, tmp_path):
+    bag = write_bag(str(tmp_path / "b.bag"), [(0.0, "/cmd_vel", twist(2.0)), (2.0, "/cmd_vel", twist(0.0))])
+    png = tmp_path / "t.png"
+    proc = replay(spec_file(write, SPEED.replace("stop;", "warn;")), bag, "--plot", str(png))
+    assert proc.returncode == 0, proc.stderr
+    assert "     0.500 s  start    behaviour 1 (line 4): warn" in proc.stdout
+    assert "     2.000 s  release  behaviour 1 (line 4)" in proc.stdout
+    assert "base.fast" in proc.stdout and "fired 1 time, active 1.500 s" in proc.stdout
+    assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" and png.stat().st_size > 5000
+
+
+def test_ticks_fire_age_rules_between_messages(write, tmp_path):
+    bag = write_bag(str(tmp_path / "b.bag"), [(0.0, "/odom", String("a")), (0.1, "/odom", String("b")),
+                                              (5.0, "/other", String("end"))])
+    spec = spec_file(write, "entity o { rules: silent: age(topic /odom) > 0.5 s; }\nif (o.silent) then { warn; }\n")
+    proc = replay(spec, bag, "--json")
+    starts = [json.loads(x) for x in proc.stdout.splitlines() if '"start"' in x]
+    assert [round(s["time"], 5) for s in starts] == [0.6]
+
+
+def test_missing_topic_is_a_warning_and_stays_unknown(write, tmp_path):
+    bag = write_bag(str(tmp_path / "b.bag"), [(0.0, "/other", Float64(1.0))])
+    proc = replay(spec_file(write, SPEED), bag, "--json")
+    assert proc.returncode == 0
+    assert f"warning: topic /cmd_vel is not in {bag}; its values stay unknown" in proc.stderr
+    assert [json.loads(x)["value"] for x in proc.stdout.splitlines()] == [None]
+
+
+def test_field_not_in_recorded_type_names_rule_field_and_type(write, tmp_path):
+    bag = write_bag(str(tmp_path / "b.bag"), [(0.0, "/cmd_vel", twist(1.0))])
+    spec = spec_file(write, "entity base { rules: fast: topic /cmd_vel.linear.q > 1; }\nif (base.fast) then { stop; }\n")
+    proc = replay(spec, bag)
+    assert proc.returncode == 1 and proc.stdout == ""
+    assert proc.stderr.strip() == (
+        "rubass replay: error: rule 'base.fast' reads /cmd_vel.linear.q, but in geometry_msgs/Twist: "
+        "'linear' (geometry_msgs/Vector3) has no field 'q' (fields: x, y, z)")
+
+
+def test_field_that_is_a_message_not_a_value(write, tmp_path):
+    bag = write_bag(str(tmp_path / "b.bag"), [(0.0, "/cmd_vel", twist(1.0))])
+    spec = spec_file(write, "entity base { rules: fast: topic /cmd_vel.linear > 1; }\nif (base.fast) then { stop; }\n")
+    proc = replay(spec, bag)
+    assert proc.returncode == 1
+    assert "'linear' is a message (geometry_msgs/Vector3), not a value" in proc.stderr
+
+
+@pytest.mark.parametrize("content,expected", [
+    (None, "no such file"),
+    (b"not a bag at all\n" * 10, "not a readable ROS 1 bag"),
+    (b"", "not a readable ROS 1 bag"),
+])
+def test_bad_bags_get_one_line_errors(write, tmp_path, content, expected):
+    path = str(tmp_path / "x.bag")
+    if content is not None:
+        with open(path, "wb") as fh:
+            fh.write(content)
+    proc = replay(spec_file(write, SPEED), path)
+    assert proc.returncode == 1
+    assert proc.stderr.startswith("rubass replay: error: ") and expected in proc.stderr
+    assert len(proc.stderr.strip().splitlines()) == 1
+
+
+def test_truncated_bag(write, tmp_path):
+    bag = write_bag(str(tmp_path / "b.bag"), [(i * 0.01, "/cmd_vel", twist(1.0)) for i in range(2000)])
+    data = open(bag, "rb").read()
+    cut = str(tmp_path / "cut.bag")
+    with open(cut, "wb") as fh:
+        fh.write(data[: len(data) // 2])
+    proc = replay(spec_file(write, SPEED), cut)
+    assert proc.returncode == 1 and proc.stderr.startswith("rubass replay: error: ")
+    assert "reindex" in proc.stderr or "not a readable" in proc.stderr or "corrupt" in proc.stderr
+
+
+def test_bad_rate_is_a_usage_error(write, tmp_path):
+    bag = write_bag(str(tmp_path / "b.bag"), [(0.0, "/cmd_vel", twist(1.0))])
+    assert replay(spec_file(write, SPEED), bag, "--rate", "0").returncode == 2
+    assert replay(spec_file(write, SPEED), bag, "--rate", "fast").returncode == 2
+
+
+def test_real_turtlebot_recording():
+    bag = shared_path("data", "turtlebot3_sim.bag")
+    spec = os.path.join(ROOT, "test", "data", "turtlebot_gap.rbs")
+    proc = replay(spec, bag, "--json")
+    assert proc.returncode == 0, proc.stderr
+    starts = [json.loads(x) for x in proc.stdout.splitlines() if '"start"' in x]
+    # /cmd_vel has one gap over 3 s (4.061 s, from 13.000 s): the silence rule fires once, 3 s
+    # into it, at the instant of the crossing rather than at the next tick
+    silent = [s["time"] for s in starts if s["behaviour"] == 1]
+    assert len(silent) == 1 and silent[0] == pytest.approx(16.0, abs=0.01)
