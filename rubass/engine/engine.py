@@ -6,7 +6,9 @@ that depend on its topic (and the rules and behaviours that use those), in depen
 """
 from __future__ import annotations
 
+import functools
 import heapq
+import itertools
 from dataclasses import dataclass
 from typing import Any, Dict, Iterable, List, Optional, Set, Tuple
 
@@ -15,6 +17,7 @@ from ..lang.model import CheckedBehaviour, CheckedSpec
 from .evaluate import Compiled, Compiler
 from .fields import FieldError, extract
 from .store import Store
+from .temporal import ForTimer
 from .values import UNKNOWN
 
 
@@ -68,7 +71,14 @@ class Engine:
         self._rules = [compiler.compile(r.expr) for r in spec.rules]
         self._behaviours = [_Behaviour(b, compiler.compile(b.cond)) for b in spec.behaviours]
         self._paths = {t: tuple(sorted(u.paths, key=str)) for t, u in spec.topics.items()}
-        self._heap: List[Tuple[float, int, int]] = []  # (due, kind 0 rule / 1 behaviour, index)
+        # (due, seq, kind 0 rule / 1 behaviour, index, the ForTimer or None, its start)
+        self._heap: List[Tuple[float, int, int, int, Optional[ForTimer], float]] = []
+        self._seq = itertools.count()
+        self._timed_pushed: Dict[Tuple[int, int], Set[float]] = {}
+        for kind, compiled_list in ((0, self._rules), (1, [b.compiled for b in self._behaviours])):
+            for idx, compiled in enumerate(compiled_list):
+                for timer in compiled.timers:
+                    timer.notify = functools.partial(self._push_timer, kind, idx)
         windows: Dict[str, float] = {}
         direct: List[Tuple[Set[str], Set[str], bool]] = []
         for expr in [r.expr for r in spec.rules] + [b.cond for b in spec.behaviours]:
@@ -135,6 +145,14 @@ class Engine:
         topic updated, the other not yet) and could restart a `for`.
         """
         events = self.advance(now, inclusive=False)
+        if isinstance(items, tuple) and len(items) == 1:  # the live case: one message, its own plan
+            topic, msg = items[0]
+            self._store_message(topic, now, msg)
+            plan = self._topic_plans.get(topic)
+            if plan is not None:
+                self._run(plan, events)
+            events += self.advance(now)
+            return events
         rules: Set[int] = set()
         behaviours: Set[int] = set()
         for topic, msg in items:
@@ -191,11 +209,11 @@ class Engine:
         `for` that a message at t falsifies never fires at t with the old data.
         """
         events: List[Event] = []
-        while self.next_deadline() is not None and (
-                self._heap[0][0] <= now if inclusive else self._heap[0][0] < now):
-            due, kind, idx = heapq.heappop(self._heap)
-            while self._heap and self._heap[0] == (due, kind, idx):
-                heapq.heappop(self._heap)
+        while True:
+            due = self.next_deadline()
+            if due is None or not (due <= now if inclusive else due < now):
+                break
+            _, _, kind, idx, _, _ = heapq.heappop(self._heap)
             self.store.now = max(self.store.now, due)
             if kind == 0:
                 self._run(self._rule_plans[idx], events)
@@ -205,14 +223,22 @@ class Engine:
         return events
 
     def next_deadline(self) -> Optional[float]:
-        """The instant a `for` timer next turns true by itself (stale entries are dropped)."""
-        while self._heap:
-            due, kind, idx = self._heap[0]
-            compiled = self._rules[idx] if kind == 0 else self._behaviours[idx].compiled
-            if due in compiled.deadlines(self.store, strict=False):
-                return due
-            heapq.heappop(self._heap)  # its cause changed since: nothing happens then
+        """The next instant a value changes by itself: a `for`, an age crossing, a frequency window."""
+        heap = self._heap
+        while heap:
+            due, _, kind, idx, timer, since = heap[0]
+            if timer is not None:
+                if timer.since == since:
+                    return due
+            else:
+                compiled = self._rules[idx] if kind == 0 else self._behaviours[idx].compiled
+                if due in compiled.time_deadlines(self.store, strict=False):
+                    return due
+            heapq.heappop(heap)  # its cause changed since: nothing happens then
         return None
+
+    def _push_timer(self, kind: int, idx: int, due: float, timer: ForTimer, since: float) -> None:
+        heapq.heappush(self._heap, (due, next(self._seq), kind, idx, timer, since))
 
     def reset(self, now: float) -> List[Event]:
         """Release latched behaviours whose condition is no longer true."""
@@ -254,5 +280,11 @@ class Engine:
                 events.append(Event(now, "release", j + 1, actions=b.actions, line=b.checked.span.line))
 
     def _schedule(self, compiled: Compiled, kind: int, idx: int) -> None:
-        for due in compiled.deadlines(self.store):
-            heapq.heappush(self._heap, (due, kind, idx))
+        if compiled.timed:
+            pushed = self._timed_pushed.setdefault((kind, idx), set())
+            for due in compiled.time_deadlines(self.store):
+                if due not in pushed:
+                    if len(pushed) > 64:  # forget old ones; a repeat push is only wasted work
+                        pushed.clear()
+                    pushed.add(due)
+                    heapq.heappush(self._heap, (due, next(self._seq), kind, idx, None, 0.0))

@@ -26,16 +26,17 @@ class Compiled:
     def __init__(self, fn: Fn, timers: List[ForTimer], ages: List[Tuple[str, float]],
                  freqs: List[Tuple[str, float]]) -> None:
         self.fn, self.timers, self.ages, self.freqs = fn, timers, ages, freqs
+        self.timed = bool(ages or freqs)
 
-    def deadlines(self, store: Store, strict: bool = True) -> List[float]:
-        """The instants after now (or at now, if not strict) at which this condition may
-        change with no new input."""
+    def time_deadlines(self, store: Store, strict: bool = True) -> List[float]:
+        """The instants after now (or at now, if not strict) at which an age crosses its
+        limit or a frequency window loses a message. (`for` timers announce their own.)"""
         now = store.now
 
         def ahead(t: float) -> bool:
             return t > now if strict else t >= now
 
-        out = [d for d in (t.deadline(now, strict) for t in self.timers) if d is not None]
+        out: List[float] = []
         for topic, limit in self.ages:
             base = store.last_arrival.get(topic, store.watch_start.get(topic))
             if base is not None and ahead(base + limit + CROSSING_MARGIN):

@@ -1,0 +1,126 @@
+"""The engine's thread: every input goes through one queue, and the thread wakes at each tick
+and at the engine's next deadline, so a `for` fires at its instant, not at the next tick.
+
+Only the standard library: the clock is injected (ROS time in the monitor, a monotonic clock
+in benchmarks, a manual one in tests), and events are handed to a callback.
+"""
+from __future__ import annotations
+
+import queue
+import threading
+from dataclasses import dataclass
+from typing import Any, Callable, List, Optional, Tuple
+
+from .engine import Engine, Event
+
+Handler = Callable[[List[Event]], None]
+
+
+@dataclass(frozen=True)
+class Message:
+    topic: str
+    time: float
+    msg: Any = None
+
+
+@dataclass(frozen=True)
+class NodeSample:
+    node: str
+    time: float
+    alive: Any
+    cpu: Any
+    memory: Any
+
+
+@dataclass(frozen=True)
+class Call:
+    """Run fn(engine) on the engine's thread (reset, reload, status) and return its result."""
+
+    fn: Callable[[Engine], Any]
+    done: "queue.Queue[Tuple[bool, Any]]"
+
+
+class EngineLoop:
+    """Owns an engine; `submit` from any thread, `run` on one."""
+
+    def __init__(self, engine: Engine, clock: Callable[[], float], rate: float, handler: Handler,
+                 max_queue: int = 100000) -> None:
+        self.engine = engine
+        self.clock = clock
+        self.period = 1.0 / rate
+        self.handler = handler
+        self.inbox: "queue.Queue[Any]" = queue.Queue(maxsize=max_queue)
+        self.dropped = 0
+        self._stop = threading.Event()
+        self._next_tick = clock() + self.period
+
+    # -- any thread ----------------------------------------------------------------------
+    def submit(self, item: Any) -> bool:
+        """Queue an input; False (and counted) if the queue is full."""
+        try:
+            self.inbox.put_nowait(item)
+            return True
+        except queue.Full:
+            self.dropped += 1
+            return False
+
+    def call(self, fn: Callable[[Engine], Any], timeout: float = 5.0) -> Any:
+        """Run fn on the engine's thread and wait for its result (its exception is re-raised)."""
+        done: "queue.Queue[Tuple[bool, Any]]" = queue.Queue(maxsize=1)
+        self.inbox.put(Call(fn, done), timeout=timeout)
+        ok, value = done.get(timeout=timeout)
+        if not ok:
+            raise value
+        return value
+
+    def stop(self) -> None:
+        self._stop.set()
+        try:
+            self.inbox.put_nowait(None)
+        except queue.Full:
+            pass
+
+    # -- the engine's thread -------------------------------------------------------------
+    def run(self) -> None:
+        while not self._stop.is_set():
+            self.step()
+
+    def step(self, max_wait: Optional[float] = None) -> None:
+        """Wait for an input or the next wake-up, then handle everything that is due."""
+        now = self.clock()
+        wake = self._next_tick
+        deadline = self.engine.next_deadline()
+        if deadline is not None and deadline < wake:
+            wake = deadline
+        timeout = max(0.0, wake - now)
+        if max_wait is not None:
+            timeout = min(timeout, max_wait)
+        try:
+            item = self.inbox.get(timeout=timeout) if timeout > 0 else self.inbox.get_nowait()
+        except queue.Empty:
+            item = None
+        if item is not None:
+            self._handle(item)
+        now = self.clock()
+        deadline = self.engine.next_deadline()
+        if deadline is not None and deadline <= now:
+            self._emit(self.engine.advance(now))
+        if now >= self._next_tick:
+            self._emit(self.engine.on_tick(now))
+            missed = int((now - self._next_tick) / self.period)
+            self._next_tick += (missed + 1) * self.period
+
+    def _handle(self, item: Any) -> None:
+        if isinstance(item, Message):
+            self._emit(self.engine.on_message(item.topic, item.time, item.msg))
+        elif isinstance(item, NodeSample):
+            self._emit(self.engine.on_node_sample(item.node, item.time, item.alive, item.cpu, item.memory))
+        elif isinstance(item, Call):
+            try:
+                item.done.put((True, item.fn(self.engine)))
+            except Exception as exc:  # handed back to the caller's thread
+                item.done.put((False, exc))
+
+    def _emit(self, events: List[Event]) -> None:
+        if events:
+            self.handler(events)
