@@ -1,0 +1,61 @@
+"""The engine loop: inputs from other threads, wake-ups at deadlines with no input, calls."""
+import os
+import threading
+import time
+
+from rubass.engine import Engine
+from rubass.engine.loop import EngineLoop, Message
+from rubass.lang import check_text
+
+from conftest import ROOT
+
+LIB = os.path.join(ROOT, "docs", "examples", "actions.yaml")
+
+
+def make(spec_body, rate=50.0):
+    spec = check_text("action primitive stop, warn;\n" + spec_body, os.path.join(ROOT, "x.rbs"), [LIB])
+    got = []
+    engine = Engine(spec, time.monotonic())
+    loop = EngineLoop(engine, time.monotonic, rate, got.extend)
+    thread = threading.Thread(target=loop.run, daemon=True)
+    thread.start()
+    return loop, thread, got
+
+
+def test_for_fires_at_its_deadline_with_no_further_input():
+    loop, thread, got = make("entity a { rules: r: (topic /x.data > 1) for 0.05 s; }\nif (a.r) then { warn; }\n",
+                             rate=1.0)  # ticks far apart: only the deadline can wake the loop
+    t0 = time.monotonic()
+    loop.submit(Message("/x", t0, {"data": 2}))
+    deadline = time.monotonic() + 3.0
+    while not any(e.kind == "start" for e in got) and time.monotonic() < deadline:
+        time.sleep(0.005)
+    loop.stop()
+    thread.join(2)
+    starts = [e for e in got if e.kind == "start"]
+    assert len(starts) == 1 and starts[0].time == t0 + 0.05
+
+
+def test_call_runs_on_the_engine_thread_and_returns_or_raises():
+    loop, thread, _ = make("entity a { rules: r: topic /x.data > 1; }\nif (a.r) then { stop; }\n")
+    assert loop.call(lambda engine: threading.current_thread() is thread)
+
+    def boom(engine):
+        raise ValueError("nope")
+
+    try:
+        loop.call(boom)
+        raised = None
+    except ValueError as exc:
+        raised = exc
+    loop.stop()
+    thread.join(2)
+    assert str(raised) == "nope"
+
+
+def test_full_queue_counts_drops_instead_of_blocking():
+    spec = check_text("action primitive warn;\nentity a { rules: r: topic /x.data > 1; }\nif (a.r) then { warn; }\n",
+                      os.path.join(ROOT, "x.rbs"), [LIB])
+    loop = EngineLoop(Engine(spec, 0.0), lambda: 0.0, 50.0, lambda events: None, max_queue=3)
+    assert [loop.submit(Message("/x", 0.0, {"data": 1})) for _ in range(5)] == [True, True, True, False, False]
+    assert loop.dropped == 2
