@@ -8,5 +8,5 @@ except ImportError:  # plain setuptools, outside a catkin build
         return kwargs
 
 setup(**generate_distutils_setup(
-    packages=["rubass", "rubass.lang", "rubass.engine", "rubass.replay", "rubass.ros"],
+    packages=["rubass", "rubass.lang", "rubass.engine", "rubass.replay", "rubass.ros", "rubass.ros.actions"],
 ))

@@ -40,7 +40,7 @@ def measure(durations, busy):
         fired = threading.Event()
         seen = {}
 
-        def handler(events, seen=seen, fired=fired):
+        def handler(events, cause, seen=seen, fired=fired):
             now = time.monotonic()
             for e in events:
                 if e.kind == "start":

@@ -64,6 +64,7 @@ class Engine:
     def __init__(self, spec: CheckedSpec, now: float) -> None:
         self.spec = spec
         self.store = Store(now)
+        self.orphans: List[_Behaviour] = []  # active behaviours of a replaced spec that this one lacks
         self.field_errors: Dict[Tuple[str, str], str] = {}
         compiler = Compiler(self.store)
         self._keys = [r.key for r in spec.rules]
@@ -169,6 +170,9 @@ class Engine:
     def _store_message(self, topic: str, now: float, msg: Any) -> None:
         self.store.arrive(topic, now)
         for path in self._paths.get(topic, ()):
+            if msg is UNKNOWN:  # the shell could not read it: its fields are missing data
+                self.store.fields[(topic, path)] = UNKNOWN
+                continue
             try:
                 value = extract(msg, path)
                 self.field_errors.pop((topic, str(path)), None)
@@ -249,9 +253,60 @@ class Engine:
                 events.append(Event(now, "release", j + 1, actions=b.actions, line=b.checked.span.line))
         return events
 
+    # -- live reload ---------------------------------------------------------------------
+    def adopt(self, old: "Engine", now: float) -> List[Event]:
+        """Take over the state of the engine this one replaces, then evaluate everything.
+
+        Data (fields, arrivals, node samples) carries over for topics and nodes both specs
+        use; a rule whose text and whose used rules' texts are unchanged keeps its value and
+        its `for` timers; a behaviour with an unchanged condition and actions keeps its state
+        (an active one does not start again). Topics new to this spec are watched from now.
+        Returns the events of the first evaluation. Call it on the engine's thread.
+        """
+        old.advance(now)
+        src, dst = old.store, self.store
+        for topic in self.spec.topics:
+            if topic in old.spec.topics:
+                dst.watch_start[topic] = src.watch_start[topic]
+                if topic in src.last_arrival:
+                    dst.last_arrival[topic] = src.last_arrival[topic]
+                dst.carry_arrivals(src, topic)
+            else:
+                dst.watch_start[topic] = now
+        dst.fields.update({k: v for k, v in src.fields.items() if k[0] in self.spec.topics})
+        dst.nodes.update({n: v for n, v in src.nodes.items() if n in self.spec.nodes})
+        dst.now = max(dst.now, now)
+        old_rules = {r.key: (r.signature, old._rules[i]) for i, r in enumerate(old.spec.rules)}
+        for i, r in enumerate(self.spec.rules):
+            prev = old_rules.get(r.key)
+            if prev is not None and prev[0] == r.signature:
+                self._take_timers(prev[1], self._rules[i])
+                if r.key in src.rules:
+                    dst.rules[r.key] = src.rules[r.key]
+        old_behaviours = {b.checked.signature: b for b in old._behaviours}
+        for b in self._behaviours:
+            prev_b = old_behaviours.pop(b.checked.signature, None)
+            if prev_b is not None:
+                self._take_timers(prev_b.compiled, b.compiled)
+                b.active, b.value = prev_b.active, prev_b.value
+        self.orphans = [b for b in old_behaviours.values() if b.active]
+        return self.evaluate_all(now)
+
+    def _take_timers(self, src: Compiled, dst: Compiled) -> None:
+        for a, b in zip(src.timers, dst.timers):
+            b.since = a.since
+            if a.since is not None and b.duration > 0:
+                self._push_timer(*b.notify.args, a.since + b.duration, b, a.since)  # type: ignore[union-attr]
+
     # -- state ---------------------------------------------------------------------------
     def rule_value(self, key: str) -> Any:
         return self.store.rules.get(key, UNKNOWN)
+
+    def behaviour_rules(self, index: int) -> List[str]:
+        """The rules a behaviour's condition names that are true now (what caused it)."""
+        cond = self._behaviours[index - 1].checked.cond
+        keys = [e.key for e in _walk(cond) if isinstance(e, ast.RuleRef)]
+        return sorted({k for k in keys if self.store.rules.get(k) is True})
 
     def active_behaviours(self) -> List[int]:
         return [j + 1 for j, b in enumerate(self._behaviours) if b.active]

@@ -13,7 +13,7 @@ from typing import Any, Callable, List, Optional, Tuple
 
 from .engine import Engine, Event
 
-Handler = Callable[[List[Event]], None]
+Handler = Callable[[List[Event], Any], None]  # (events, cause: the input item, or None for a wake-up)
 
 
 @dataclass(frozen=True)
@@ -21,6 +21,7 @@ class Message:
     topic: str
     time: float
     msg: Any = None
+    received: float = 0.0  # wall-clock arrival, to measure reaction latency
 
 
 @dataclass(frozen=True)
@@ -44,11 +45,12 @@ class EngineLoop:
     """Owns an engine; `submit` from any thread, `run` on one."""
 
     def __init__(self, engine: Engine, clock: Callable[[], float], rate: float, handler: Handler,
-                 max_queue: int = 100000) -> None:
+                 max_queue: int = 100000, tick_hook: Optional[Callable[[float], None]] = None) -> None:
         self.engine = engine
         self.clock = clock
         self.period = 1.0 / rate
         self.handler = handler
+        self.tick_hook = tick_hook
         self.inbox: "queue.Queue[Any]" = queue.Queue(maxsize=max_queue)
         self.dropped = 0
         self._stop = threading.Event()
@@ -104,23 +106,27 @@ class EngineLoop:
         now = self.clock()
         deadline = self.engine.next_deadline()
         if deadline is not None and deadline <= now:
-            self._emit(self.engine.advance(now))
+            self._emit(self.engine.advance(now), None)
         if now >= self._next_tick:
-            self._emit(self.engine.on_tick(now))
+            self._emit(self.engine.on_tick(now), None)
+            if self.tick_hook is not None:
+                self.tick_hook(now)
             missed = int((now - self._next_tick) / self.period)
             self._next_tick += (missed + 1) * self.period
+            if missed > 0 or self._next_tick > now + 2 * self.period:  # the clock jumped (sim time, NTP)
+                self._next_tick = now + self.period
 
     def _handle(self, item: Any) -> None:
         if isinstance(item, Message):
-            self._emit(self.engine.on_message(item.topic, item.time, item.msg))
+            self._emit(self.engine.on_message(item.topic, item.time, item.msg), item)
         elif isinstance(item, NodeSample):
-            self._emit(self.engine.on_node_sample(item.node, item.time, item.alive, item.cpu, item.memory))
+            self._emit(self.engine.on_node_sample(item.node, item.time, item.alive, item.cpu, item.memory), item)
         elif isinstance(item, Call):
             try:
                 item.done.put((True, item.fn(self.engine)))
             except Exception as exc:  # handed back to the caller's thread
                 item.done.put((False, exc))
 
-    def _emit(self, events: List[Event]) -> None:
+    def _emit(self, events: List[Event], cause: Any) -> None:
         if events:
-            self.handler(events)
+            self.handler(events, cause)

@@ -35,6 +35,10 @@ class Store:
             if len(arr) > 64 and arr[len(arr) // 2] < now - window:  # drop the old half at once
                 del arr[: bisect.bisect_left(arr, now - window)]
 
+    def carry_arrivals(self, other: "Store", topic: str) -> None:
+        """Keep the arrival times another store recorded for a topic (live reload)."""
+        self._arrivals[topic] = list(other._arrivals.get(topic, []))
+
     def age(self, topic: str) -> Any:
         last = self.last_arrival.get(topic, self.watch_start.get(topic))
         return UNKNOWN if last is None else max(0.0, self.now - last)

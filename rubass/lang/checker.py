@@ -4,6 +4,7 @@ Every problem in a spec is reported in one run; kinds and units are checked by t
 """
 from __future__ import annotations
 
+import dataclasses
 import os
 from typing import Dict, FrozenSet, List, Optional, Sequence, Set, Tuple
 
@@ -266,6 +267,7 @@ def check(spec: ast.Spec, sources: SourceSet, extra_libraries: Sequence[str] = (
         c.diags.sort(key=lambda d: (d.span.file != spec.file, d.span.file, d.span.line, d.span.col))
         return None, c.diags, c.warnings
     rules = _build_rules(c, checked, order)
+    behaviours = _sign_behaviours(behaviours, rules)
     topics, nodes = _uses([r.expr for r in rules] + [b.cond for b in behaviours])
     consts = {n: lit.value for n, (lit, _) in c.const_values.items()}
     return (CheckedSpec(spec.file, spec, rules, behaviours, consts, library, topics, nodes, loaded,
@@ -284,17 +286,33 @@ def _build_rules(c: _Checker, checked: Dict[str, ast.Expr], order: List[str]) ->
     return rules
 
 
+def _sign_behaviours(behaviours: List[CheckedBehaviour], rules: List[CheckedRule]) -> List[CheckedBehaviour]:
+    """A behaviour's signature also covers the rules it names, as a rule's covers its rules."""
+    sigs = {r.key: r.signature for r in rules}
+    out = []
+    for b in behaviours:
+        keys = sorted({e.key for e in _walk(b.cond) if isinstance(e, ast.RuleRef)})
+        out.append(dataclasses.replace(b, signature=b.signature + "".join(f" [{k}: {sigs[k]}]" for k in keys)))
+    return out
+
+
+def _walk(expr: ast.Expr) -> List[ast.Expr]:
+    out, stack = [], [expr]
+    while stack:
+        e = stack.pop()
+        out.append(e)
+        stack.extend(ast.children(e))
+    return out
+
+
 def _uses(exprs: Sequence[ast.Expr]) -> Tuple[Dict[str, TopicUse], FrozenSet[str]]:
     paths: Dict[str, Set[Tuple[ast.PathElem, ...]]] = {}
     nodes: Set[str] = set()
-    stack = list(exprs)
-    while stack:
-        e = stack.pop()
+    for e in (x for expr in exprs for x in _walk(expr)):
         if isinstance(e, ast.TopicRef):
             paths.setdefault(e.topic, set())
             if e.path:
                 paths[e.topic].add(e.path)
         elif isinstance(e, ast.NodeRef):
             nodes.add(e.node)
-        stack.extend(ast.children(e))
     return {t: TopicUse(t, frozenset(p)) for t, p in paths.items()}, frozenset(nodes)

@@ -85,3 +85,37 @@ def test_a_message_reevaluates_only_its_dependents():
     e = engine(body + "if (e0.r) then { warn; }\n")
     events = e.on_message("/t7", 1.0, {"data": 5})
     assert [ev.rule for ev in events] == ["e7.r"]
+
+
+def build(body, now):
+    spec = check_text("action primitive stop, warn;\n" + body, os.path.join(ROOT, "x.rbs"), [LIB])
+    return Engine(spec, now)
+
+
+def test_reload_keeps_unchanged_rules_timers_and_active_behaviours():
+    a = "entity a { rules: r: (topic /x.data > 1) for 1 s; q: topic /y.data > 1; }\n"
+    old = build(a + "if (a.r) then { warn; }\nif (a.q) then { stop; }\n", 0.0)
+    old.evaluate_all(0.0)
+    old.on_message("/x", 0.5, {"data": 2})
+    old.on_message("/y", 0.6, {"data": 2})  # behaviour 2 active
+    new = build(a.replace("q: topic /y.data > 1", "q: topic /y.data > 5") + "if (a.q) then { stop; }\n"
+                "if (a.r) then { warn; }\n", 0.0)
+    events = new.adopt(old, 0.8)
+    assert new.next_deadline() == 1.5  # the unchanged `for` keeps counting from 0.5
+    assert [(e.kind, e.behaviour) for e in events if e.kind != "rule"] == []  # `if (a.r)` did not restart
+    assert new.rule_value("a.q") is False  # changed rule re-evaluated on the kept data
+    assert [(e.kind, e.behaviour) for e in new.advance(2.0) if e.kind != "rule"] == [("start", 2)]
+    assert [b.checked.index for b in new.orphans] == [2]  # old `if (a.q)` (stop) was active, is gone
+
+
+def test_reload_watches_new_topics_from_the_swap():
+    old = build("entity a { rules: r: topic /x.data > 1; }\nif (a.r) then { warn; }\n", 0.0)
+    new = build("entity a { rules: r: age(topic /z) > 1 s; }\nif (a.r) then { warn; }\n", 0.0)
+    new.adopt(old, 10.0)
+    assert new.next_deadline() == 11.0 + 1e-6
+
+
+def test_behaviour_rules_names_the_true_causes():
+    e = engine("entity a { rules: p: topic /x.data > 1; q: topic /y.data > 1; }\nif (a.p or a.q) then { warn; }\n")
+    e.on_message("/y", 1.0, {"data": 3})
+    assert e.behaviour_rules(1) == ["a.q"]

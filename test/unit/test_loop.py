@@ -16,7 +16,7 @@ def make(spec_body, rate=50.0):
     spec = check_text("action primitive stop, warn;\n" + spec_body, os.path.join(ROOT, "x.rbs"), [LIB])
     got = []
     engine = Engine(spec, time.monotonic())
-    loop = EngineLoop(engine, time.monotonic, rate, got.extend)
+    loop = EngineLoop(engine, time.monotonic, rate, lambda events, cause: got.extend(events))
     thread = threading.Thread(target=loop.run, daemon=True)
     thread.start()
     return loop, thread, got
@@ -56,6 +56,6 @@ def test_call_runs_on_the_engine_thread_and_returns_or_raises():
 def test_full_queue_counts_drops_instead_of_blocking():
     spec = check_text("action primitive warn;\nentity a { rules: r: topic /x.data > 1; }\nif (a.r) then { warn; }\n",
                       os.path.join(ROOT, "x.rbs"), [LIB])
-    loop = EngineLoop(Engine(spec, 0.0), lambda: 0.0, 50.0, lambda events: None, max_queue=3)
+    loop = EngineLoop(Engine(spec, 0.0), lambda: 0.0, 50.0, lambda events, cause: None, max_queue=3)
     assert [loop.submit(Message("/x", 0.0, {"data": 1})) for _ in range(5)] == [True, True, True, False, False]
     assert loop.dropped == 2

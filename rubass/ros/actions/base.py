@@ -1,0 +1,151 @@
+"""What an action plugin is: configured from its library entry, set up before the first tick,
+then driven through start / hold / release by its own runner thread."""
+from __future__ import annotations
+
+import importlib
+from dataclasses import dataclass, field
+from typing import Any, Dict, List, Optional, Tuple
+
+from ...lang.library import ActionDef
+
+
+class ActionSetupError(Exception):
+    """An action that cannot work as configured (unknown type, bad message fields, …)."""
+
+
+@dataclass(frozen=True)
+class Context:
+    """Why a phase runs: the behaviour, its line, the rules that made it true, the call's arguments."""
+
+    behaviour: int
+    line: int
+    rules: Tuple[str, ...] = ()
+    args: Tuple[Any, ...] = ()
+    time: float = 0.0
+    key: Any = None  # the behaviour's identity across reloads (its signature); None: use `behaviour`
+
+    @property
+    def ident(self) -> Any:
+        return self.behaviour if self.key is None else self.key
+
+
+@dataclass
+class ActionStats:
+    calls: int = 0
+    failures: int = 0
+    last_error: str = ""
+    last_call_s: float = 0.0
+    extra: Dict[str, Any] = field(default_factory=dict)
+
+
+class ActionPlugin:
+    """Base class of the built-in plugins; custom plugins need only start/hold/release.
+
+    per_behaviour: every behaviour's start and release is passed on (a log line each);
+    otherwise the runner reference-counts: start when the first behaviour using the action
+    starts, release when the last one releases.
+    period: periodic() is called this often (seconds), whether active or not.
+    """
+
+    per_behaviour = False
+    period: Optional[float] = None
+
+    def __init__(self, action: ActionDef) -> None:
+        self.action = action
+        self.name = action.name
+        self.params = dict(action.params)
+        self.active = False
+
+    def setup(self) -> None:
+        """Open publishers, ports, proxies; ActionSetupError for a configuration that cannot work."""
+
+    def start(self, ctx: Context) -> None:
+        """The behaviour turned true."""
+
+    def hold(self, ctx: Context) -> None:
+        """A tick while active."""
+
+    def release(self, ctx: Context) -> None:
+        """The behaviour turned false (or was reset)."""
+
+    def periodic(self) -> None:
+        """Called every `period` seconds."""
+
+    def close(self) -> None:
+        """Release resources at shutdown or when a reload drops the action."""
+
+
+class CustomPlugin(ActionPlugin):
+    """Adapts a robot's own class, named in YAML as 'package.module:Class'.
+
+    The class is built as Class(name, params) and needs start(ctx), hold(ctx), release(ctx);
+    setup() and close() are called when it has them.
+    """
+
+    def __init__(self, action: ActionDef) -> None:
+        super().__init__(action)
+        module_name, _, class_name = action.plugin.partition(":")
+        try:
+            module = importlib.import_module(module_name)
+        except Exception as exc:  # ImportError, or the module's own import-time error
+            raise ActionSetupError(f"action '{action.name}': cannot import plugin module '{module_name}': "
+                                   f"{exc.__class__.__name__}: {exc}") from None
+        cls = getattr(module, class_name, None)
+        if cls is None:
+            raise ActionSetupError(f"action '{action.name}': module '{module_name}' has no class '{class_name}'")
+        try:
+            self.impl = cls(action.name, dict(action.params))
+        except Exception as exc:
+            raise ActionSetupError(f"action '{action.name}': {action.plugin}({action.name!r}, params) failed: "
+                                   f"{exc.__class__.__name__}: {exc}") from None
+        missing = [m for m in ("start", "hold", "release") if not callable(getattr(self.impl, m, None))]
+        if missing:
+            raise ActionSetupError(f"action '{action.name}': {action.plugin} lacks {', '.join(missing)}()")
+        self.per_behaviour = bool(getattr(self.impl, "per_behaviour", False))
+        self.period = getattr(self.impl, "period", None)
+
+    def setup(self) -> None:
+        if callable(getattr(self.impl, "setup", None)):
+            self.impl.setup()
+
+    def start(self, ctx: Context) -> None:
+        self.impl.start(ctx)
+
+    def hold(self, ctx: Context) -> None:
+        self.impl.hold(ctx)
+
+    def release(self, ctx: Context) -> None:
+        self.impl.release(ctx)
+
+    def periodic(self) -> None:
+        if callable(getattr(self.impl, "periodic", None)):
+            self.impl.periodic()
+
+    def close(self) -> None:
+        if callable(getattr(self.impl, "close", None)):
+            self.impl.close()
+
+
+def make_plugin(action: ActionDef) -> ActionPlugin:
+    """The plugin object for a library action (not yet set up)."""
+    if action.is_custom:
+        return CustomPlugin(action)
+    if action.plugin == "publish":
+        from .publish import PublishPlugin
+        return PublishPlugin(action)
+    if action.plugin == "serial":
+        from .serial_port import SerialPlugin
+        return SerialPlugin(action)
+    if action.plugin == "service":
+        from .service import ServicePlugin
+        return ServicePlugin(action)
+    from .log import LogPlugin
+    return LogPlugin(action)
+
+
+def describe(ctx: Context) -> str:
+    rules = f" ({', '.join(ctx.rules)})" if ctx.rules else ""
+    return f"behaviour {ctx.behaviour} (line {ctx.line}){rules}"
+
+
+__all__: List[str] = ["ActionPlugin", "ActionSetupError", "ActionStats", "Context", "CustomPlugin", "make_plugin"]

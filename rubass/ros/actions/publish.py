@@ -1,0 +1,65 @@
+"""The `publish` plugin: a message once at start and then at its rate while active."""
+from __future__ import annotations
+
+from typing import Any, Dict, Optional
+
+import genpy
+import roslib.message
+import rospy
+
+from .base import ActionPlugin, ActionSetupError, Context
+
+
+def build_message(cls: Any, fields: Dict[str, Any], where: str) -> Any:
+    """A message of class cls with the YAML field values; ActionSetupError naming the field."""
+    msg = cls()
+    try:
+        genpy.message.fill_message_args(msg, [fields] if fields else [])
+        msg.serialize(_Sink())  # catches values of the wrong type now, not at the first stop
+    except (genpy.MessageException, ValueError, TypeError, AttributeError, KeyError, Exception) as exc:
+        raise ActionSetupError(f"{where}: {exc}") from None
+    return msg
+
+
+class _Sink:
+    def write(self, data: bytes) -> None:
+        pass
+
+
+class PublishPlugin(ActionPlugin):
+    def __init__(self, action: Any) -> None:
+        super().__init__(action)
+        self.period = 1.0 / float(self.params["rate"])
+        self.pub: Optional[rospy.Publisher] = None
+
+    def setup(self) -> None:
+        type_name = self.params["type"]
+        try:
+            cls = roslib.message.get_message_class(type_name)
+        except Exception:
+            cls = None
+        if cls is None:
+            raise ActionSetupError(f"action '{self.name}': unknown message type '{type_name}' "
+                                   f"(is its package installed?)")
+        self.msg = build_message(cls, self.params.get("message") or {}, f"action '{self.name}': message")
+        release = self.params.get("on_release")
+        self.release_msg = None if release is None else build_message(cls, release, f"action '{self.name}': on_release")
+        # created at start-up, so that subscribers are connected before the first violation
+        self.pub = rospy.Publisher(self.params["topic"], cls, queue_size=10, tcp_nodelay=True)
+
+    def start(self, ctx: Context) -> None:
+        assert self.pub is not None
+        self.pub.publish(self.msg)
+
+    def periodic(self) -> None:
+        if self.active and self.pub is not None:
+            self.pub.publish(self.msg)
+
+    def release(self, ctx: Context) -> None:
+        if self.release_msg is not None and self.pub is not None:
+            self.pub.publish(self.release_msg)
+
+    def close(self) -> None:
+        if self.pub is not None:
+            self.pub.unregister()
+            self.pub = None

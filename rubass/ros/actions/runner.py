@@ -1,0 +1,136 @@
+"""One thread per action: phases run in order off the engine's thread, holds are coalesced,
+and a failing start or release is retried until it succeeds or is superseded.
+
+submit() never blocks: the engine thread hands over and goes on evaluating.
+"""
+from __future__ import annotations
+
+import collections
+import threading
+import time
+from typing import Any, Callable, Deque, Optional, Set, Tuple
+
+from .base import ActionPlugin, ActionStats, Context
+
+Log = Callable[[str, str], None]  # (level, text)
+BACKOFF = (0.05, 0.1, 0.2, 0.5, 1.0)
+LOG_EVERY = 5.0  # seconds between two log lines about the same failing action
+
+
+class ActionRunner:
+    def __init__(self, plugin: ActionPlugin, log: Log) -> None:
+        self.plugin = plugin
+        self.log = log
+        self.stats = ActionStats()
+        self._cond = threading.Condition()
+        self._queue: Deque[Tuple[str, Context]] = collections.deque()
+        self._hold_pending = False
+        self._active: Set[Any] = set()  # identities of the behaviours this action is active for
+        self._stop = False
+        self._last_log = 0.0
+        self._thread: Optional[threading.Thread] = None
+
+    @property
+    def active(self) -> bool:
+        return bool(self._active)
+
+    def start_thread(self) -> None:
+        self._thread = threading.Thread(target=self._run, name=f"rubass-action-{self.plugin.name}", daemon=True)
+        self._thread.start()
+
+    # -- the engine's thread -------------------------------------------------------------
+    def submit(self, kind: str, ctx: Context) -> None:
+        per = self.plugin.per_behaviour
+        with self._cond:
+            if kind == "start":
+                if ctx.ident in self._active:
+                    return
+                first = not self._active
+                self._active.add(ctx.ident)
+                self.plugin.active = True
+                if per or first:
+                    self._queue.append((kind, ctx))
+            elif kind == "release":
+                if ctx.ident not in self._active:
+                    return
+                self._active.discard(ctx.ident)
+                if not self._active:
+                    self.plugin.active = False
+                if per or not self._active:
+                    self._queue.append((kind, ctx))
+            else:
+                if self._hold_pending or not self._active:
+                    return
+                self._hold_pending = True
+                self._queue.append((kind, ctx))
+            self._cond.notify()
+
+    def stop(self, timeout: float = 2.0) -> None:
+        with self._cond:
+            self._stop = True
+            self._cond.notify()
+        if self._thread is not None:
+            self._thread.join(timeout)
+
+    # -- the runner's thread -------------------------------------------------------------
+    def _run(self) -> None:
+        period = self.plugin.period
+        next_periodic = time.monotonic() + period if period else float("inf")
+        while True:
+            with self._cond:
+                while not self._queue and not self._stop:
+                    wait = next_periodic - time.monotonic()
+                    if wait <= 0:
+                        break
+                    self._cond.wait(min(wait, 1.0))
+                if self._stop and not self._queue:
+                    return
+                item = self._queue.popleft() if self._queue else None
+                if item is not None and item[0] == "hold":
+                    self._hold_pending = False
+            if item is not None:
+                self._do(*item)
+            if period and time.monotonic() >= next_periodic:
+                self._guard("periodic", self.plugin.periodic)
+                next_periodic = max(next_periodic + period, time.monotonic())
+
+    def _superseded(self, kind: str, ctx: Context) -> bool:
+        with self._cond:
+            if self._stop:
+                return kind != "release"
+            mine = ctx.ident in self._active if self.plugin.per_behaviour else bool(self._active)
+            return (kind == "start" and not mine) or (kind == "release" and mine)
+
+    def _do(self, kind: str, ctx: Context) -> None:
+        call = {"start": self.plugin.start, "hold": self.plugin.hold, "release": self.plugin.release}[kind]
+        attempt = 0
+        while attempt == 0 or not self._superseded(kind, ctx):  # retries only, never the first try
+            if self._guard(kind, lambda: call(ctx)) or kind == "hold":
+                return
+            delay = BACKOFF[min(attempt, len(BACKOFF) - 1)]
+            attempt += 1
+            with self._cond:
+                if self._stop and kind != "release":
+                    return
+                self._cond.wait(delay)
+            if self._stop and attempt > 3:
+                return  # at shutdown a release is tried a few times, not forever
+
+    def _guard(self, what: str, fn: Callable[[], None]) -> bool:
+        t0 = time.monotonic()
+        try:
+            fn()
+        except Exception as exc:  # a plugin's failure must never reach the engine
+            self.stats.failures += 1
+            self.stats.last_error = f"{what}: {exc.__class__.__name__}: {exc}"
+            now = time.monotonic()
+            if now - self._last_log >= LOG_EVERY:
+                self._last_log = now
+                self.log("error", f"action '{self.plugin.name}' {what} failed ({self.stats.failures} failures so "
+                                  f"far; retrying): {exc.__class__.__name__}: {exc}")
+            return False
+        finally:
+            self.stats.last_call_s = time.monotonic() - t0
+        if what != "periodic":
+            self.stats.calls += 1
+        return True

@@ -1,0 +1,61 @@
+"""The `service` plugin: calls a ROS service with fixed request fields, with a timeout."""
+from __future__ import annotations
+
+import threading
+from typing import Any, List
+
+import roslib.message
+import rospy
+
+from .base import ActionPlugin, ActionSetupError, Context
+from .publish import build_message
+
+
+class ServicePlugin(ActionPlugin):
+    def setup(self) -> None:
+        type_name = self.params["type"]
+        try:
+            cls = roslib.message.get_service_class(type_name)
+        except Exception:
+            cls = None
+        if cls is None:
+            raise ActionSetupError(f"action '{self.name}': unknown service type '{type_name}' "
+                                   f"(is its package installed?)")
+        self.request = build_message(cls._request_class, self.params.get("request") or {},
+                                     f"action '{self.name}': request")
+        self.proxy = rospy.ServiceProxy(self.params["service"], cls)
+
+    def _call(self) -> None:
+        """Call with a timeout; a call that hangs is abandoned (its thread is a daemon)."""
+        timeout = float(self.params["timeout"])
+        result: List[Any] = []
+
+        def call() -> None:
+            try:
+                self.proxy.wait_for_service(timeout)
+                result.append(self.proxy.call(self.request))
+            except Exception as exc:  # rospy.ServiceException, ROSException, ROSInterruptException
+                result.append(exc)
+
+        worker = threading.Thread(target=call, name=f"rubass-service-{self.name}", daemon=True)
+        worker.start()
+        worker.join(timeout)
+        if not result:
+            raise TimeoutError(f"service {self.params['service']} did not answer within {timeout:g} s")
+        if isinstance(result[0], Exception):
+            raise IOError(f"service {self.params['service']}: {result[0]}")
+
+    def start(self, ctx: Context) -> None:
+        if "start" in self.params["call_on"]:
+            self._call()
+
+    def hold(self, ctx: Context) -> None:
+        if "hold" in self.params["call_on"]:
+            self._call()
+
+    def release(self, ctx: Context) -> None:
+        if "release" in self.params["call_on"]:
+            self._call()
+
+    def close(self) -> None:
+        self.proxy.close()

@@ -1,0 +1,86 @@
+"""From engine events to actions: each start, hold and release goes to the runners of the
+behaviour's actions, and each start and release is reported on ~events with its latency.
+
+Runs on the engine's thread; it only hands over (runners never block it)."""
+from __future__ import annotations
+
+import time
+from typing import Any, Callable, Dict, List, Optional
+
+from ..engine import Engine, Event
+from ..engine.loop import Message, NodeSample
+from ..lang.model import CheckedBehaviour
+from .actions.base import Context
+from .actions.runner import ActionRunner
+
+Report = Callable[[Dict[str, Any]], None]
+
+
+class Dispatcher:
+    def __init__(self, runners: Dict[str, ActionRunner], report: Report, ros_now: Callable[[], float]) -> None:
+        self.runners = runners
+        self.report = report
+        self.ros_now = ros_now
+        self.latencies: List[float] = []  # seconds, last 1000 starts
+        self.orphans: List[Any] = []  # (behaviour, key): latched, from a spec a reload replaced
+        self._keys_for: Any = None
+        self._keys: Dict[int, Any] = {}
+
+    @staticmethod
+    def keys(behaviours: List[CheckedBehaviour]) -> Dict[int, Any]:
+        """Each behaviour's identity across reloads: its signature, numbered among identical twins."""
+        seen: Dict[str, int] = {}
+        out: Dict[int, Any] = {}
+        for b in behaviours:
+            seen[b.signature] = seen.get(b.signature, 0) + 1
+            out[b.index] = (b.signature, seen[b.signature])
+        return out
+
+    def handle(self, engine: Engine, events: List[Event], cause: Any) -> None:
+        spec = engine.spec
+        for e in events:
+            if e.kind not in ("start", "hold", "release"):
+                continue
+            b = spec.behaviours[e.behaviour - 1]
+            rules = tuple(engine.behaviour_rules(e.behaviour)) if e.kind != "hold" else ()
+            self.send(e.kind, b, Context(e.behaviour, b.span.line, rules, (), e.time, self.keys_of(spec)[e.behaviour]))
+            if e.kind != "hold":
+                self.report_event(e, b, rules, cause)
+
+    def keys_of(self, spec: Any) -> Dict[int, Any]:
+        if self._keys_for is not spec:
+            self._keys_for, self._keys = spec, self.keys(spec.behaviours)
+        return self._keys
+
+    def send(self, kind: str, b: CheckedBehaviour, ctx: Context) -> None:
+        for bound in b.actions:
+            runner = self.runners.get(bound.name)
+            if runner is not None:
+                runner.submit(kind, Context(ctx.behaviour, ctx.line, ctx.rules, bound.args, ctx.time, ctx.key))
+
+    def report_event(self, e: Event, b: CheckedBehaviour, rules: tuple, cause: Any) -> None:
+        latency: Optional[float]
+        if isinstance(cause, Message) and cause.received:
+            source, latency = f"message on {cause.topic}", time.time() - cause.received
+        elif isinstance(cause, NodeSample):
+            source, latency = f"node sample of {cause.node}", None
+        elif cause == "reset":
+            source, latency = "reset service", None
+        elif cause == "reload":
+            source, latency = "reload", None
+        else:
+            source, latency = "deadline", max(0.0, self.ros_now() - e.time)
+        if e.kind == "start" and latency is not None:
+            self.latencies.append(latency)
+            del self.latencies[:-1000]
+        self.report({
+            "time": e.time, "event": e.kind, "behaviour": e.behaviour, "line": b.span.line,
+            "actions": [a.name for a in b.actions], "rules": list(rules), "cause": source,
+            "latency_ms": None if latency is None else round(latency * 1000.0, 3),
+        })
+
+    def release_orphans(self, now: float) -> None:
+        """Release latched actions of behaviours that a reload removed (called by ~reset)."""
+        for b, key in self.orphans:
+            self.send("release", b, Context(b.index, b.span.line, (), (), now, key))
+        self.orphans = []

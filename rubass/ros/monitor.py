@@ -1,0 +1,290 @@
+"""The rubass monitor node: enforces a RuBaSS spec on a live ROS 1 system.
+
+ROS API
+-------
+Parameters (private)
+    ~spec (string, required)      the spec file (.rbs)
+    ~actions (list of strings)    action libraries to load besides the spec's imports
+    ~rate (Hz, default 50)        scheduler ticks: `hold`, `age`/`frequency` re-evaluation, heartbeat
+    ~node_rate (Hz, default 10)   node samples for alive(), cpu(), memory()
+    ~diagnostics_rate (Hz, 1)     /diagnostics publications
+Subscribes
+    every topic the spec names, whatever its type (rospy.AnyMsg, tcp_nodelay)
+Publishes
+    /diagnostics (diagnostic_msgs/DiagnosticArray)  one status per entity, one for the monitor
+    ~events (std_msgs/String)     one JSON object per behaviour start and release (docs/monitor.md)
+    ~heartbeat (std_msgs/Header)  at the tick rate, from the engine's thread
+    and whatever the spec's publish actions publish
+Services
+    ~reload (std_srvs/Trigger)    re-read spec and libraries; a broken spec is rejected
+    ~reset (std_srvs/Trigger)     release latched actions whose cause is gone
+Signals
+    SIGHUP reloads as ~reload; SIGINT/SIGTERM release non-latched actions, close ports, exit 0
+"""
+from __future__ import annotations
+
+import signal
+import sys
+import threading
+import time
+from typing import Any, Dict, List, Optional, Tuple
+
+import rospy
+from std_srvs.srv import Trigger, TriggerResponse
+
+from ..engine import Engine
+from ..engine.loop import EngineLoop, Message, NodeSample
+from ..lang import SpecError, load_spec
+from ..lang.model import CheckedSpec
+from . import status as status_mod
+from .actions.base import ActionSetupError, make_plugin
+from .actions.runner import ActionRunner
+from .dispatch import Dispatcher
+from .nodes import NodeSampler
+from .outputs import Outputs
+from .params import MonitorConfig, ParamError, read_config
+from .topics import TopicWatcher
+
+
+class StartupError(Exception):
+    """The monitor cannot start: the message says why, for the user."""
+
+
+def _log(level: str, text: str) -> None:
+    {"debug": rospy.logdebug, "info": rospy.loginfo, "warn": rospy.logwarn, "error": rospy.logerr}[level](text)
+
+
+def _ros_now() -> float:
+    return rospy.get_rostime().to_sec()
+
+
+class Monitor:
+    def __init__(self, config: MonitorConfig) -> None:
+        self.config = config
+        self.reloads = 0
+        self.rejected = 0
+        self.last_reload_error = ""
+        self._reload_lock = threading.Lock()
+        self._stopping = False
+
+    # -- start-up ------------------------------------------------------------------------
+    def load(self) -> Tuple[CheckedSpec, Dict[str, ActionRunner]]:
+        """Check the spec and build its actions; StartupError with every problem found."""
+        try:
+            spec = load_spec(self.config.spec, self.config.actions)
+        except SpecError as exc:
+            raise StartupError(exc.render()) from None
+        for w in spec.warnings:
+            rospy.logwarn("rubass: %s", w.render(spec.sources))
+        return spec, self._runners(spec, {})
+
+    def _runners(self, spec: CheckedSpec, keep: Dict[str, ActionRunner]) -> Dict[str, ActionRunner]:
+        """Runners for the spec's actions, reusing those whose definition did not change."""
+        out: Dict[str, ActionRunner] = {}
+        try:
+            for name, action in spec.actions.items():
+                old = keep.get(name)
+                if old is not None and old.plugin.action == action and old.plugin.params == dict(action.params):
+                    out[name] = old
+                    continue
+                plugin = make_plugin(action)
+                plugin.setup()
+                out[name] = ActionRunner(plugin, _log)
+        except ActionSetupError as exc:
+            for name, runner in out.items():
+                if keep.get(name) is not runner:
+                    runner.plugin.close()
+            raise StartupError(str(exc)) from None
+        return out
+
+    def setup(self) -> None:
+        spec, runners = self.load()
+        self.spec = spec
+        self.runners = runners
+        self.outputs = Outputs()
+        self.dispatcher = Dispatcher(runners, self.outputs.event, _ros_now)
+        now = _ros_now()
+        engine = Engine(spec, now)
+        self.loop = EngineLoop(engine, _ros_now, self.config.rate,
+                               lambda events, cause: self.dispatcher.handle(self.loop.engine, events, cause),
+                               tick_hook=self.outputs.beat)
+        for runner in runners.values():
+            runner.start_thread()
+        self.dispatcher.handle(engine, engine.evaluate_all(now), "reload")
+        self.watcher = TopicWatcher(self._on_message, _log)
+        self.watcher.sync(spec)
+        self.sampler = self._sampler(spec)
+        rospy.Service("~reload", Trigger, lambda req: TriggerResponse(*self.reload("service")))
+        rospy.Service("~reset", Trigger, lambda req: TriggerResponse(*self.reset()))
+        signal.signal(signal.SIGHUP, lambda signum, frame: threading.Thread(
+            target=self.reload, args=("SIGHUP",), name="rubass-reload", daemon=True).start())
+        rospy.loginfo("rubass: enforcing %s (%d rules, %d behaviours, %d topics, %d nodes)", spec.path,
+                      len(spec.rules), len(spec.behaviours), len(spec.topics), len(spec.nodes))
+
+    def _sampler(self, spec: CheckedSpec) -> NodeSampler:
+        nodes = [(n, rospy.resolve_name(n)) for n in sorted(spec.nodes)]
+        sampler = NodeSampler(nodes, self._on_node, _ros_now, 1.0 / self.config.node_rate, rospy.get_name())
+        sampler.start()
+        return sampler
+
+    def _on_message(self, topic: str, now: float, msg: Any, wall: float) -> None:
+        self.loop.submit(Message(topic, now, msg, wall))
+
+    def _on_node(self, node: str, now: float, alive: Any, cpu: Any, memory: Any) -> None:
+        self.loop.submit(NodeSample(node, now, alive, cpu, memory))
+
+    # -- running -------------------------------------------------------------------------
+    def run(self) -> None:
+        thread = threading.Thread(target=self._engine_thread, name="rubass-engine", daemon=True)
+        thread.start()
+        period = 1.0 / self.config.diagnostics_rate
+        while not rospy.is_shutdown():
+            try:
+                self.publish_status()
+            except Exception as exc:  # the status must never take the monitor down
+                rospy.logerr_throttle(10, f"rubass: status failed: {exc}")
+            deadline = time.monotonic() + period
+            while not rospy.is_shutdown() and time.monotonic() < deadline:
+                time.sleep(0.05)
+        self.shutdown()
+        thread.join(2.0)
+
+    def _engine_thread(self) -> None:
+        while not self._stopping:
+            try:
+                self.loop.step(max_wait=0.1)
+            except Exception as exc:  # a bug must not silently stop enforcement: log and go on
+                rospy.logerr_throttle(1, f"rubass: engine step failed: {exc.__class__.__name__}: {exc}")
+
+    # -- control -------------------------------------------------------------------------
+    def reload(self, reason: str) -> Tuple[bool, str]:
+        """Re-read spec and libraries; swap atomically, or keep the old rules on any error."""
+        with self._reload_lock:
+            t0 = time.monotonic()
+            try:
+                spec = load_spec(self.config.spec, self.config.actions)
+                runners = self._runners(spec, self.runners)
+            except (SpecError, StartupError) as exc:
+                text = exc.render() if isinstance(exc, SpecError) else str(exc)
+                self.rejected += 1
+                self.last_reload_error = text.splitlines()[0] if text else "error"
+                rospy.logerr("rubass: reload (%s) rejected, the previous rules keep running:\n%s", reason, text)
+                return False, f"rejected: {text}"
+            new_engine = Engine(spec, _ros_now())
+            for name, runner in runners.items():
+                if self.runners.get(name) is not runner:
+                    runner.start_thread()
+            self.loop.call(lambda old: self._swap(old, new_engine, spec, runners))
+            self.watcher.sync(spec)
+            if spec.nodes != self.spec.nodes:
+                self.sampler.stop()
+                self.sampler = self._sampler(spec)
+            dropped = [r for n, r in self.runners.items() if runners.get(n) is not r]
+            self.spec, self.runners = spec, runners
+            for runner in dropped:
+                runner.stop()
+                runner.plugin.close()
+            self.reloads += 1
+            self.last_reload_error = ""
+            ms = (time.monotonic() - t0) * 1000.0
+            rospy.loginfo("rubass: reloaded %s (%s) in %.0f ms: %d rules, %d behaviours", spec.path, reason, ms,
+                          len(spec.rules), len(spec.behaviours))
+            return True, f"reloaded in {ms:.0f} ms: {len(spec.rules)} rules, {len(spec.behaviours)} behaviours"
+
+    def _swap(self, old: Engine, new: Engine, spec: CheckedSpec, runners: Dict[str, ActionRunner]) -> None:
+        """On the engine's thread: nothing is evaluated between the old rules and the new."""
+        now = _ros_now()
+        events = new.adopt(old, now)
+        old_keys = Dispatcher.keys(old.spec.behaviours)
+        for orphan in new.orphans:
+            b = orphan.checked
+            if b.latched:
+                self.dispatcher.orphans.append((b, old_keys[b.index]))
+            else:
+                from .actions.base import Context
+                self.dispatcher.send("release", b, Context(b.index, b.span.line, (), (), now, old_keys[b.index]))
+        self.dispatcher.runners = runners
+        self.loop.engine = new
+        self.dispatcher.handle(new, events, "reload")
+
+    def reset(self) -> Tuple[bool, str]:
+        now = _ros_now()
+
+        def do(engine: Engine) -> int:
+            events = engine.reset(now)
+            self.dispatcher.handle(engine, events, "reset")
+            n = len(self.dispatcher.orphans)
+            self.dispatcher.release_orphans(now)
+            return sum(e.kind == "release" for e in events) + n
+
+        released = self.loop.call(do)
+        still = self.loop.call(lambda engine: engine.active_behaviours())
+        msg = f"released {released} latched behaviour{'s' if released != 1 else ''}"
+        if still:
+            msg += f"; still active (cause present): {', '.join(str(i) for i in still)}"
+        rospy.loginfo("rubass: reset: %s", msg)
+        return True, msg
+
+    def publish_status(self) -> None:
+        def snapshot(engine: Engine) -> Tuple[Dict[str, Any], List[int], Dict[Tuple[str, str], str]]:
+            return dict(engine.store.rules), engine.active_behaviours(), dict(engine.field_errors)
+
+        rules, active, field_errors = self.loop.call(snapshot)
+        topics = {s.spec_name: {"messages": s.messages, "errors": s.errors, "type": s.type}
+                  for s in self.watcher.status()}
+        nodes = {s.spec_name: {"why": s.why} for s in self.sampler.status.values()}
+        failures = sum(r.stats.failures for r in self.runners.values())
+        lat = sorted(self.dispatcher.latencies)
+        monitor: Dict[str, Any] = {
+            "spec": self.spec.path, "reloads": self.reloads, "rejected reloads": self.rejected,
+            "last reload error": self.last_reload_error, "dropped messages": self.loop.dropped,
+            "action failures": failures,
+            "reaction latency p50 ms": f"{lat[len(lat) // 2] * 1000:.3f}" if lat else "n/a",
+        }
+        for name, r in self.runners.items():
+            if r.stats.last_error:
+                monitor[f"action {name}"] = r.stats.last_error
+        entries = status_mod.build(self.spec, rules, active, topics, nodes, field_errors, monitor)
+        self.outputs.status(entries, _ros_now())
+
+    def shutdown(self) -> None:
+        """Release non-latched actions, close ports and publishers."""
+        if self._stopping:
+            return
+        now = _ros_now()
+
+        def release(engine: Engine) -> None:
+            keys = Dispatcher.keys(engine.spec.behaviours)
+            from .actions.base import Context
+            for index in engine.active_behaviours():
+                b = engine.spec.behaviours[index - 1]
+                if not b.latched:
+                    self.dispatcher.send("release", b, Context(index, b.span.line, (), (), now, keys[index]))
+
+        try:
+            self.loop.call(release, timeout=1.0)
+        except Exception:
+            pass
+        self._stopping = True
+        self.loop.stop()
+        self.sampler.stop()
+        self.watcher.close()
+        for runner in self.runners.values():
+            runner.stop(timeout=1.0)
+            runner.plugin.close()
+
+
+def main(argv: Optional[List[str]] = None) -> int:
+    rospy.init_node("rubass_monitor", argv=argv)
+    sys.setswitchinterval(0.0005)  # a busy thread must not delay a deadline by the default 5 ms
+    try:
+        config = read_config(lambda name, default: rospy.get_param("~" + name, default))
+        monitor = Monitor(config)
+        monitor.setup()
+    except (ParamError, StartupError) as exc:
+        rospy.logfatal("rubass: cannot start:\n%s", exc)
+        print(f"rubass monitor: cannot start:\n{exc}", file=sys.stderr)
+        rospy.signal_shutdown("cannot start")
+        return 1
+    monitor.run()
+    return 0

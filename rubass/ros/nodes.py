@@ -1,0 +1,143 @@
+"""Node liveness, CPU and memory, sampled on a thread of its own.
+
+`alive` asks the node itself (XML-RPC getPid, with a timeout) rather than trusting the
+master, which never forgets a dead node; a node hung with SIGSTOP still accepts connections,
+so only the timeout finds it. CPU and memory come from psutil, for nodes on this host.
+"""
+from __future__ import annotations
+
+import concurrent.futures
+import socket
+import threading
+import time
+import xmlrpc.client
+from dataclasses import dataclass
+from typing import Any, Callable, Dict, List, Optional, Set, Tuple
+from urllib.parse import urlparse
+
+import psutil
+import rosgraph
+
+from ..engine.values import UNKNOWN
+
+Submit = Callable[[str, float, Any, Any, Any], None]  # (spec node, ROS time, alive, cpu, memory)
+
+
+class _TimeoutTransport(xmlrpc.client.Transport):
+    def __init__(self, timeout: float) -> None:
+        super().__init__()
+        self.timeout = timeout
+
+    def make_connection(self, host: Any) -> Any:
+        conn = super().make_connection(host)
+        conn.timeout = self.timeout
+        return conn
+
+
+@dataclass
+class NodeStatus:
+    spec_name: str
+    resolved: str
+    alive: Any = UNKNOWN
+    cpu: Any = UNKNOWN
+    memory: Any = UNKNOWN
+    pid: Optional[int] = None
+    why: str = "not sampled yet"
+
+
+def _local_addresses() -> Set[str]:
+    names = {"localhost", socket.gethostname(), socket.getfqdn()}
+    for addrs in psutil.net_if_addrs().values():
+        names.update(a.address for a in addrs)
+    return names
+
+
+class NodeSampler:
+    def __init__(self, nodes: List[Tuple[str, str]], submit: Submit, now: Callable[[], float], period: float,
+                 caller_id: str, timeout: float = 0.1) -> None:
+        self.status: Dict[str, NodeStatus] = {r: NodeStatus(n, r) for n, r in nodes}
+        self.submit, self.now, self.period, self.timeout = submit, now, period, timeout
+        self.caller_id = caller_id
+        self._procs: Dict[int, psutil.Process] = {}
+        self._uris: Dict[str, str] = {}
+        self._local = _local_addresses()
+        self._hosts: Dict[str, bool] = {}
+        self._stop = threading.Event()
+        self._thread: Optional[threading.Thread] = None
+        self._pool = concurrent.futures.ThreadPoolExecutor(max_workers=max(1, min(8, len(nodes))),
+                                                           thread_name_prefix="rubass-node")
+
+    def start(self) -> None:
+        if self.status:
+            self._thread = threading.Thread(target=self._run, name="rubass-nodes", daemon=True)
+            self._thread.start()
+
+    def stop(self) -> None:
+        self._stop.set()
+        if self._thread is not None:
+            self._thread.join(2.0)
+        self._pool.shutdown(wait=False)
+
+    def _run(self) -> None:
+        next_at = time.monotonic()
+        while not self._stop.is_set():
+            list(self._pool.map(self.sample, list(self.status.values())))
+            next_at += self.period
+            delay = next_at - time.monotonic()
+            if delay < 0:
+                next_at = time.monotonic()
+            self._stop.wait(max(0.0, delay))
+
+    def sample(self, st: NodeStatus) -> None:
+        alive, pid, why = self._ask(st.resolved)
+        cpu: Any = UNKNOWN
+        memory: Any = UNKNOWN
+        if alive is True and pid is not None:
+            uri = self._uris.get(st.resolved, "")
+            if self._is_local(urlparse(uri).hostname or ""):
+                cpu, memory, why = self._measure(pid)
+            else:
+                why = f"on host {urlparse(uri).hostname}, not this one: cpu and memory are unknown"
+        st.alive, st.cpu, st.memory, st.pid, st.why = alive, cpu, memory, pid, why
+        self.submit(st.spec_name, self.now(), alive, cpu, memory)
+
+    def _ask(self, name: str) -> Tuple[Any, Optional[int], str]:
+        try:
+            uri = rosgraph.Master(self.caller_id).lookupNode(name)
+            self._uris[name] = uri
+        except rosgraph.MasterError:
+            return False, None, "not registered with the master"
+        except (OSError, socket.error, xmlrpc.client.Error) as exc:
+            uri = self._uris.get(name)
+            if uri is None:
+                return UNKNOWN, None, f"the master cannot be reached ({exc}) and the node was never seen"
+        try:
+            proxy = xmlrpc.client.ServerProxy(uri, transport=_TimeoutTransport(self.timeout))
+            code, msg, pid = proxy.getPid(self.caller_id)
+        except socket.timeout:
+            return False, None, f"did not answer getPid within {self.timeout * 1000:.0f} ms (hung?)"
+        except (OSError, xmlrpc.client.Error, ValueError) as exc:
+            return False, None, f"does not answer at {uri}: {exc}"
+        if code != 1:
+            return False, None, f"getPid failed: {msg}"
+        return True, int(pid), "alive"
+
+    def _is_local(self, host: str) -> bool:
+        if host not in self._hosts:
+            try:
+                self._hosts[host] = host in self._local or socket.gethostbyname(host) in self._local
+            except OSError:
+                self._hosts[host] = False
+        return self._hosts[host]
+
+    def _measure(self, pid: int) -> Tuple[Any, Any, str]:
+        proc = self._procs.get(pid)
+        try:
+            if proc is None:
+                proc = self._procs[pid] = psutil.Process(pid)
+                proc.cpu_percent(None)  # the first reading only starts the count
+                return UNKNOWN, float(proc.memory_info().rss), "alive (cpu known from the next sample)"
+            return proc.cpu_percent(None) / 100.0, float(proc.memory_info().rss), "alive"
+        except (psutil.NoSuchProcess, psutil.AccessDenied, psutil.ZombieProcess) as exc:
+            self._procs.pop(pid, None)
+            return UNKNOWN, UNKNOWN, f"cannot measure process {pid}: {exc.__class__.__name__}"

@@ -1,0 +1,42 @@
+"""The monitor's own publications: /diagnostics, ~events (JSON) and ~heartbeat."""
+from __future__ import annotations
+
+import json
+import socket
+from typing import Any, Dict, List
+
+import rospy
+from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
+from std_msgs.msg import Header, String
+
+from .status import Entry
+
+
+class Outputs:
+    def __init__(self) -> None:
+        self.events = rospy.Publisher("~events", String, queue_size=1000, tcp_nodelay=True)
+        self.heartbeat = rospy.Publisher("~heartbeat", Header, queue_size=1, tcp_nodelay=True)
+        self.diagnostics = rospy.Publisher("/diagnostics", DiagnosticArray, queue_size=5)
+        self._seq = 0
+        self._hw = socket.gethostname()
+
+    def beat(self, now: float) -> None:
+        """One heartbeat; published from the engine's thread, so it stops if the engine stalls."""
+        self._seq += 1
+        self.heartbeat.publish(Header(seq=self._seq, stamp=rospy.Time.from_sec(now), frame_id="rubass"))
+
+    def event(self, record: Dict[str, Any]) -> None:
+        self.events.publish(String(data=json.dumps(record, sort_keys=True)))
+
+    def status(self, entries: List[Entry], now: float) -> None:
+        arr = DiagnosticArray()
+        arr.header.stamp = rospy.Time.from_sec(now)
+        for e in entries:
+            arr.status.append(DiagnosticStatus(level=e.level, name=e.name,
+                                               message=e.message, hardware_id=self._hw,
+                                               values=[KeyValue(key=k, value=v) for k, v in e.values]))
+        self.diagnostics.publish(arr)
+
+    def close(self) -> None:
+        for pub in (self.events, self.heartbeat, self.diagnostics):
+            pub.unregister()

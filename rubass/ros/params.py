@@ -1,0 +1,59 @@
+"""The monitor's private parameters, validated with messages a user can act on."""
+from __future__ import annotations
+
+import os
+from dataclasses import dataclass, field
+from typing import Any, Callable, List
+
+from ..lang.units import FREQUENCY, parse_quantity
+
+Getter = Callable[[str, Any], Any]
+_MISSING = object()
+
+
+class ParamError(Exception):
+    """A missing or bad parameter; the message names it and says what is expected."""
+
+
+@dataclass(frozen=True)
+class MonitorConfig:
+    spec: str
+    actions: List[str] = field(default_factory=list)
+    rate: float = 50.0       # scheduler ticks per second
+    node_rate: float = 10.0  # node samples per second
+    diagnostics_rate: float = 1.0
+
+
+def _rate(get: Getter, name: str, default: float, lo: float, hi: float) -> float:
+    value = get(name, default)
+    q = None
+    if isinstance(value, (int, float)) and not isinstance(value, bool):
+        q = (float(value), FREQUENCY)
+    elif isinstance(value, str):
+        q = parse_quantity(value)
+    if q is None or (q[1] and q[1] != FREQUENCY) or not lo <= q[0] <= hi:
+        raise ParamError(f"~{name} must be a rate from {lo:g} to {hi:g} Hz (a number or e.g. '50 Hz'), "
+                         f"got {value!r}")
+    return q[0]
+
+
+def read_config(get: Getter) -> MonitorConfig:
+    """The configuration from a param getter (rospy.get_param with '~' names, or a dict's get)."""
+    spec = get("spec", _MISSING)
+    if spec is _MISSING:
+        raise ParamError("~spec is required: the RuBaSS spec to enforce, e.g. "
+                         "'rosrun rubass monitor _spec:=/path/to/safety.rbs'")
+    if not isinstance(spec, str) or not spec.strip():
+        raise ParamError(f"~spec must be the path of a .rbs file, got {spec!r}")
+    actions = get("actions", [])
+    if isinstance(actions, str):
+        actions = [a for a in actions.replace(",", " ").split() if a]
+    if not isinstance(actions, list) or not all(isinstance(a, str) and a for a in actions):
+        raise ParamError(f"~actions must be a list of action library paths, got {actions!r}")
+    return MonitorConfig(
+        spec=os.path.expanduser(spec),
+        actions=[os.path.expanduser(a) for a in actions],
+        rate=_rate(get, "rate", 50.0, 1.0, 1000.0),
+        node_rate=_rate(get, "node_rate", 10.0, 0.1, 100.0),
+        diagnostics_rate=_rate(get, "diagnostics_rate", 1.0, 0.1, 10.0),
+    )

@@ -1,0 +1,90 @@
+"""What the monitor reports in /diagnostics: one status per entity and one for itself.
+
+Pure: built from plain snapshots, so it is tested without ROS.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any, Dict, List, Tuple
+
+from ..lang import ast
+from ..lang.model import CheckedSpec
+
+OK, WARN, ERROR, STALE = 0, 1, 2, 3
+
+
+@dataclass
+class Entry:
+    name: str
+    level: int
+    message: str
+    values: List[Tuple[str, str]] = field(default_factory=list)
+
+
+def _text(v: Any) -> str:
+    return "unknown" if v is None or (v is not True and v is not False) else ("true" if v else "false")
+
+
+def unknown_reasons(spec: CheckedSpec, rule_key: str, topics: Dict[str, Dict[str, Any]],
+                    nodes: Dict[str, Dict[str, Any]], field_errors: Dict[Tuple[str, str], str]) -> List[str]:
+    """Why a rule may be unknown: silent topics, bad fields, unmeasurable nodes."""
+    why: List[str] = []
+    stack = [spec.rule(rule_key).expr]
+    while stack:
+        e = stack.pop()
+        stack.extend(ast.children(e))
+        if isinstance(e, ast.TopicRef) and e.path:
+            t = topics.get(e.topic, {})
+            if not t.get("messages"):
+                why.append(f"no message on {e.topic} yet")
+            for err in t.get("errors", []):
+                why.append(err)
+            fe = field_errors.get((e.topic, str(e.path)))
+            if fe:
+                why.append(f"{e.topic}: {fe}")
+        elif isinstance(e, ast.NodeRef):
+            n = nodes.get(e.node)
+            if n is not None and n.get("why") not in (None, "alive"):
+                why.append(f"node {e.node}: {n['why']}")
+    return sorted(set(why))
+
+
+def build(spec: CheckedSpec, rules: Dict[str, Any], active: List[int], topics: Dict[str, Dict[str, Any]],
+          nodes: Dict[str, Dict[str, Any]], field_errors: Dict[Tuple[str, str], str],
+          monitor: Dict[str, Any]) -> List[Entry]:
+    """Entries for every entity (WARN while one of its rules is true, ERROR on data errors) and the monitor."""
+    out: List[Entry] = []
+    by_entity: Dict[str, List[str]] = {}
+    for r in spec.rules:
+        by_entity.setdefault(r.entity, []).append(r.key)
+    for entity, keys in by_entity.items():
+        values: List[Tuple[str, str]] = []
+        true_rules, unknown, errors = [], [], []
+        for key in keys:
+            v = rules.get(key)
+            values.append((key.split(".", 1)[1], _text(v)))
+            if v is True:
+                true_rules.append(key)
+            elif v is not False:
+                reasons = unknown_reasons(spec, key, topics, nodes, field_errors)
+                unknown.append(key)
+                if reasons:
+                    values.append((f"{key.split('.', 1)[1]} unknown because", "; ".join(reasons)))
+                errors += [r for r in reasons if "reads" in r or "changed type" in r or "deserialise" in r]
+        if errors:
+            level, msg = ERROR, f"data errors: {len(set(errors))}"
+        elif true_rules:
+            level, msg = WARN, "violated: " + ", ".join(k.split(".", 1)[1] for k in true_rules)
+        elif unknown:
+            level, msg = OK, "unknown: " + ", ".join(k.split(".", 1)[1] for k in unknown)
+        else:
+            level, msg = OK, "all rules false"
+        out.append(Entry(f"rubass: {entity}", level, msg, values))
+    mvalues = [(k, str(v)) for k, v in monitor.items()]
+    mvalues.append(("active behaviours", ", ".join(str(i) for i in active) or "none"))
+    level = ERROR if monitor.get("last reload error") or monitor.get("action failures") else OK
+    msg = f"enforcing {spec.path}: {len(spec.rules)} rules, {len(spec.behaviours)} behaviours"
+    if monitor.get("last reload error"):
+        msg += " (the last reload was rejected; the previous rules still run)"
+    out.append(Entry("rubass: monitor", level, msg, mvalues))
+    return out

@@ -1,0 +1,159 @@
+"""Dynamic subscriptions: one rospy.AnyMsg subscriber per topic the spec names, whatever its
+type. The type comes from each connection's header; messages are deserialised only for
+topics whose fields the spec reads; field paths are checked when a topic's type is first
+seen (and again when it changes)."""
+from __future__ import annotations
+
+import threading
+import time
+from dataclasses import dataclass, field
+from typing import Any, Callable, Dict, List, Optional, Tuple
+
+import genpy
+import genpy.dynamic
+import roslib.message
+import rospy
+
+from ..engine.values import UNKNOWN
+from ..lang import ast
+from ..lang.model import CheckedSpec
+from .msgtypes import check_path
+
+Submit = Callable[[str, float, Any, float], None]  # (spec topic, ROS time, message or None, wall time)
+Log = Callable[[str, str], None]
+
+
+@dataclass
+class TopicState:
+    """What the monitor knows about one watched topic (for its status)."""
+
+    spec_name: str
+    resolved: str
+    paths: Dict[Tuple[ast.PathElem, ...], List[str]]  # field path -> rules reading it
+    type: str = ""
+    md5: str = ""
+    messages: int = 0
+    errors: List[str] = field(default_factory=list)
+    subscriber: Optional[rospy.Subscriber] = None
+    cls: Any = None
+
+
+def field_users(spec: CheckedSpec) -> Dict[str, Dict[Tuple[ast.PathElem, ...], List[str]]]:
+    """topic -> field path -> the rules and behaviours that read it."""
+    out: Dict[str, Dict[Tuple[ast.PathElem, ...], List[str]]] = {t: {} for t in spec.topics}
+    owners = [(f"rule '{r.key}'", r.expr) for r in spec.rules] + \
+             [(f"behaviour {b.index} (line {b.span.line})", b.cond) for b in spec.behaviours]
+    for owner, expr in owners:
+        stack = [expr]
+        while stack:
+            e = stack.pop()
+            stack.extend(ast.children(e))
+            if isinstance(e, ast.TopicRef) and e.path:
+                users = out[e.topic].setdefault(e.path, [])
+                if owner not in users:
+                    users.append(owner)
+    return out
+
+
+class TopicWatcher:
+    def __init__(self, submit: Submit, log: Log) -> None:
+        self.submit = submit
+        self.log = log
+        self.topics: Dict[str, TopicState] = {}  # by resolved name
+        self._lock = threading.Lock()
+        self._classes: Dict[str, Any] = {}  # md5 -> class
+
+    def sync(self, spec: CheckedSpec) -> None:
+        """Subscribe to the spec's topics, unsubscribe from those it no longer names."""
+        wanted = {rospy.resolve_name(t): t for t in spec.topics}
+        users = field_users(spec)
+        with self._lock:
+            for resolved in [r for r in self.topics if r not in wanted]:
+                state = self.topics.pop(resolved)
+                if state.subscriber is not None:
+                    state.subscriber.unregister()
+            for resolved, name in wanted.items():
+                state = self.topics.get(resolved)
+                if state is None:
+                    state = TopicState(name, resolved, users[name])
+                    self.topics[resolved] = state
+                    state.subscriber = rospy.Subscriber(resolved, rospy.AnyMsg, self._callback,
+                                                        callback_args=state, tcp_nodelay=True)
+                else:
+                    state.spec_name, state.paths = name, users[name]
+                    if state.cls is not None:
+                        state.errors = self._check(state)
+
+    def close(self) -> None:
+        with self._lock:
+            for state in self.topics.values():
+                if state.subscriber is not None:
+                    state.subscriber.unregister()
+            self.topics.clear()
+
+    def _callback(self, raw: Any, state: TopicState) -> None:
+        now = rospy.get_rostime().to_sec()
+        wall = time.time()
+        state.messages += 1
+        if not state.paths:
+            self.submit(state.spec_name, now, None, wall)  # age/frequency only: never deserialised
+            return
+        header = getattr(raw, "_connection_header", None) or {}
+        md5 = header.get("md5sum", "")
+        if md5 != state.md5:
+            self._new_type(state, header)
+        if state.cls is None:
+            self.submit(state.spec_name, now, UNKNOWN, wall)
+            return
+        try:
+            msg = state.cls().deserialize(raw._buff)
+        except (genpy.DeserializationError, ValueError, TypeError, IndexError, Exception) as exc:
+            if not state.errors or not state.errors[-1].startswith("cannot deserialise"):
+                state.errors.append(f"cannot deserialise a {state.type} message: {exc}")
+                self.log("error", f"topic {state.resolved}: {state.errors[-1]}")
+            msg = UNKNOWN
+        self.submit(state.spec_name, now, msg, wall)
+
+    def _new_type(self, state: TopicState, header: Dict[str, str]) -> None:
+        old = state.type
+        state.type, state.md5 = header.get("type", "?"), header.get("md5sum", "")
+        state.cls = self._class(state.type, state.md5, header.get("message_definition", ""))
+        if old and old != state.type:
+            self.log("error", f"topic {state.resolved} changed type from {old} to {state.type}")
+        state.errors = [] if state.cls is not None else [f"cannot load message type {state.type}"]
+        if old and old != state.type:
+            state.errors.append(f"changed type from {old} to {state.type}")
+        state.errors += self._check(state)
+        for e in state.errors:
+            self.log("error", f"topic {state.resolved}: {e}")
+
+    def _check(self, state: TopicState) -> List[str]:
+        out = []
+        for path, owners in state.paths.items():
+            problem = check_path(state.cls, path) if state.cls is not None else None
+            if problem:
+                field_text = "".join(f"[{p}]" if isinstance(p, int) else f".{p}" for p in path)
+                out.append(f"{' and '.join(owners)} reads {state.spec_name}{field_text}, but in {state.type}: "
+                           f"{problem}; its value stays unknown")
+        return out
+
+    def _class(self, type_name: str, md5: str, definition: str) -> Any:
+        cls = self._classes.get(md5)
+        if cls is not None:
+            return cls
+        try:
+            cls = roslib.message.get_message_class(type_name)
+        except Exception:
+            cls = None
+        if cls is None or getattr(cls, "_md5sum", md5) != md5:
+            try:  # a type not installed here, or another version of it: build it from the publisher's definition
+                cls = genpy.dynamic.generate_dynamic(type_name, definition)[type_name]
+            except Exception:
+                cls = None
+        if cls is not None:
+            self._classes[md5] = cls
+        return cls
+
+    def status(self) -> List[TopicState]:
+        with self._lock:
+            return list(self.topics.values())
