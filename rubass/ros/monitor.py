@@ -66,6 +66,7 @@ class Monitor:
         self.last_reload_error = ""
         self._reload_lock = threading.Lock()
         self._stopping = False
+        self._exit = threading.Event()
 
     # -- start-up ------------------------------------------------------------------------
     def load(self) -> Tuple[CheckedSpec, Dict[str, ActionRunner]]:
@@ -118,6 +119,10 @@ class Monitor:
         rospy.Service("~reset", Trigger, lambda req: TriggerResponse(*self.reset()))
         signal.signal(signal.SIGHUP, lambda signum, frame: threading.Thread(
             target=self.reload, args=("SIGHUP",), name="rubass-reload", daemon=True).start())
+        # our own SIGINT/SIGTERM: release actions while publishers still work, then stop rospy
+        # (after rospy's own handler, publish() silently does nothing)
+        for sig in (signal.SIGINT, signal.SIGTERM):
+            signal.signal(sig, lambda signum, frame: self._exit.set())
         rospy.loginfo("rubass: enforcing %s (%d rules, %d behaviours, %d topics, %d nodes)", spec.path,
                       len(spec.rules), len(spec.behaviours), len(spec.topics), len(spec.nodes))
 
@@ -138,16 +143,15 @@ class Monitor:
         thread = threading.Thread(target=self._engine_thread, name="rubass-engine", daemon=True)
         thread.start()
         period = 1.0 / self.config.diagnostics_rate
-        while not rospy.is_shutdown():
+        while not rospy.is_shutdown() and not self._exit.is_set():
             try:
                 self.publish_status()
             except Exception as exc:  # the status must never take the monitor down
                 rospy.logerr_throttle(10, f"rubass: status failed: {exc}")
-            deadline = time.monotonic() + period
-            while not rospy.is_shutdown() and time.monotonic() < deadline:
-                time.sleep(0.05)
+            self._exit.wait(period)
         self.shutdown()
         thread.join(2.0)
+        rospy.signal_shutdown("rubass monitor stopped")
 
     def _engine_thread(self) -> None:
         while not self._stopping:
@@ -261,10 +265,11 @@ class Monitor:
                 if not b.latched:
                     self.dispatcher.send("release", b, Context(index, b.span.line, (), (), now, keys[index]))
 
+        rospy.loginfo("rubass: stopping: releasing non-latched actions")
         try:
             self.loop.call(release, timeout=1.0)
-        except Exception:
-            pass
+        except Exception as exc:  # the engine thread is stuck: stop anyway
+            rospy.logerr(f"rubass: could not release actions at shutdown: {exc}")
         self._stopping = True
         self.loop.stop()
         self.sampler.stop()
@@ -275,7 +280,7 @@ class Monitor:
 
 
 def main(argv: Optional[List[str]] = None) -> int:
-    rospy.init_node("rubass_monitor", argv=argv)
+    rospy.init_node("rubass_monitor", argv=argv, disable_signals=True)  # Monitor handles SIGINT/SIGTERM
     sys.setswitchinterval(0.0005)  # a busy thread must not delay a deadline by the default 5 ms
     try:
         config = read_config(lambda name, default: rospy.get_param("~" + name, default))

@@ -6,6 +6,7 @@ import subprocess
 import pytest
 
 from conftest import ROOT
+from rosharness import ros  # noqa: F401
 
 pytestmark = [pytest.mark.ros, pytest.mark.slow]
 
@@ -44,3 +45,17 @@ def test_rubass_is_on_path_and_package_paths_resolve(workspace, tmp_path):
                     "entity e { rules: r: topic /x.data > 1; }\nif (e.r) then { stop; }\n")
     proc = in_workspace(workspace, f"rubass check {spec}")
     assert proc.returncode == 0, proc.stderr
+
+
+def test_rosrun_starts_the_monitor_from_the_workspace(workspace, ros, tmp_path):
+    (tmp_path / "s.rbs").write_text('import "package://rubass/config/kobuki_actions.yaml";\n'
+                                    "action primitive stop;\nentity e { rules: r: topic /x.data > 1; }\n"
+                                    "if (e.r) then { stop; }\n")
+    env = {k: v for k, v in ros.env.items() if k not in ("PYTHONPATH", "ROS_PACKAGE_PATH")}
+    cmd = f"source {workspace}/devel/setup.bash && exec rosrun rubass monitor __name:=rubass _spec:={tmp_path}/s.rbs"
+    proc = subprocess.Popen(["bash", "-c", cmd], env=env, cwd="/", stdout=open(tmp_path / "mon.log", "w"),
+                            stderr=subprocess.STDOUT, start_new_session=True)
+    ros.procs.append(proc)
+    proc.log_path = tmp_path / "mon.log"
+    ros.wait_service("/rubass/reset", proc, timeout=30)
+    assert "success: True" in ros.call("/rubass/reset").stdout

@@ -101,3 +101,15 @@ def test_slow_plugin_never_blocks_submit_and_holds_coalesce():
     time.sleep(0.5)
     r.stop()
     assert p.calls.count(("hold", 1)) <= 2
+
+
+def test_queue_stays_bounded_when_a_stuck_plugin_meets_a_flapping_condition():
+    from rubass.ros.actions import runner as runner_mod
+
+    p = Fake(slow=5.0, per_behaviour=True)
+    r, _ = runner(p)
+    for _ in range(3000):
+        r.submit("start", Context(1, 0))
+        r.submit("release", Context(1, 0))
+    assert len(r._queue) <= runner_mod.MAX_PENDING + 1
+    assert r.stats.extra["dropped pairs"] > 0

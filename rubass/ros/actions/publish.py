@@ -12,11 +12,12 @@ from .base import ActionPlugin, ActionSetupError, Context
 
 def build_message(cls: Any, fields: Dict[str, Any], where: str) -> Any:
     """A message of class cls with the YAML field values; ActionSetupError naming the field."""
-    msg = cls()
+    msg = cls()  # every field zero, empty or false
     try:
-        genpy.message.fill_message_args(msg, [fields] if fields else [])
+        if fields:
+            genpy.message.fill_message_args(msg, [fields])
         msg.serialize(_Sink())  # catches values of the wrong type now, not at the first stop
-    except (genpy.MessageException, ValueError, TypeError, AttributeError, KeyError, Exception) as exc:
+    except Exception as exc:  # genpy raises MessageException, ValueError, TypeError, struct.error, …
         raise ActionSetupError(f"{where}: {exc}") from None
     return msg
 

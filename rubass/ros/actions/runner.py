@@ -14,6 +14,7 @@ from .base import ActionPlugin, ActionStats, Context
 
 Log = Callable[[str, str], None]  # (level, text)
 BACKOFF = (0.05, 0.1, 0.2, 0.5, 1.0)
+MAX_PENDING = 1000  # phases waiting for a plugin that is slower than the condition flaps
 LOG_EVERY = 5.0  # seconds between two log lines about the same failing action
 
 
@@ -63,7 +64,25 @@ class ActionRunner:
                     return
                 self._hold_pending = True
                 self._queue.append((kind, ctx))
+            if len(self._queue) > MAX_PENDING:
+                self._compact()
             self._cond.notify()
+
+    def _compact(self) -> None:
+        """Bound the queue: drop the oldest start that its own release follows (the pair is moot)."""
+        items = list(self._queue)
+        for i, (kind, ctx) in enumerate(items):
+            if kind == "start":
+                j = next((j for j in range(i + 1, len(items))
+                          if items[j][0] == "release" and items[j][1].ident == ctx.ident), None)
+                if j is not None:
+                    del items[j]
+                    del items[i]
+                    self.stats.extra["dropped pairs"] = self.stats.extra.get("dropped pairs", 0) + 1
+                    break
+        else:
+            items.pop(0)
+        self._queue = collections.deque(items)
 
     def stop(self, timeout: float = 2.0) -> None:
         with self._cond:

@@ -1,0 +1,124 @@
+"""Integration-test harness: a private rosmaster per test, the monitor and probes as processes."""
+import json
+import os
+import signal
+import socket
+import subprocess
+import sys
+import time
+
+import pytest
+
+from conftest import ROOT
+
+PROBE = os.path.join(ROOT, "test", "integration", "probe.py")
+PY = "/usr/bin/python3"
+
+
+def free_port():
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+class Ros:
+    """A master on a free port and the environment every process of the test gets."""
+
+    def __init__(self, tmp_path):
+        if not os.path.exists("/usr/bin/rosmaster"):
+            pytest.skip("ROS 1 is not installed (rosmaster)")
+        self.tmp = tmp_path
+        self.port = free_port()
+        self.env = dict(os.environ, ROS_MASTER_URI=f"http://127.0.0.1:{self.port}", ROS_IP="127.0.0.1",
+                        ROS_HOME=str(tmp_path / "ros_home"), ROS_LOG_DIR=str(tmp_path / "ros_log"),
+                        PYTHONPATH=ROOT + os.pathsep + os.environ.get("PYTHONPATH", ""),
+                        PYTHONDONTWRITEBYTECODE="1", PYTHONUNBUFFERED="1")
+        self.env.pop("ROS_HOSTNAME", None)
+        self.procs = []
+        self.master = self.spawn(["rosmaster", "--core", "-p", str(self.port)], "master")
+        self.wait_master()
+
+    def wait_master(self, timeout=10.0):
+        import rosgraph
+
+        end = time.time() + timeout
+        while time.time() < end:
+            if rosgraph.is_master_online(f"http://127.0.0.1:{self.port}"):
+                # roscore sets /run_id; roslaunch waits for it; a bare rosmaster does not set it
+                import uuid
+
+                rosgraph.Master("/test", master_uri=f"http://127.0.0.1:{self.port}").setParam(
+                    "/run_id", str(uuid.uuid1()))
+                return
+            time.sleep(0.05)
+        raise RuntimeError("rosmaster did not come up")
+
+    def spawn(self, cmd, name, **kw):
+        log = open(self.tmp / f"{name}.log", "w")
+        proc = subprocess.Popen(cmd, env=self.env, stdout=kw.pop("stdout", log), stderr=subprocess.STDOUT,
+                                cwd=str(self.tmp), start_new_session=True, **kw)
+        proc.log_path = self.tmp / f"{name}.log"
+        self.procs.append(proc)
+        return proc
+
+    def monitor(self, spec, name="rubass", wait=True, **params):
+        args = [PY, os.path.join(ROOT, "scripts", "monitor"), f"__name:={name}", f"_spec:={spec}"]
+        args += [f"_{k}:={v}" for k, v in params.items()]
+        proc = self.spawn(args, f"monitor-{name}")
+        if wait:
+            self.wait_service(f"/{name}/reset", proc)
+        return proc
+
+    def wait_service(self, service, proc=None, timeout=15.0):
+        import rosgraph
+
+        master = rosgraph.Master("/test", master_uri=f"http://127.0.0.1:{self.port}")
+        end = time.time() + timeout
+        while time.time() < end:
+            if proc is not None and proc.poll() is not None:
+                raise AssertionError(f"process exited {proc.returncode}:\n{self.log(proc)}")
+            try:
+                master.lookupService(service)
+                return
+            except rosgraph.MasterError:
+                time.sleep(0.05)
+        raise AssertionError(f"{service} never came up")
+
+    def probe(self, plan, timeout=60):
+        """Run a probe to completion; its records."""
+        out = subprocess.run([PY, PROBE, json.dumps(plan)], env=self.env, capture_output=True, text=True,
+                             timeout=timeout, cwd=str(self.tmp))
+        assert out.returncode == 0, out.stderr
+        return [json.loads(line) for line in out.stdout.splitlines() if line.startswith("{")]
+
+    def probe_bg(self, plan, name="probe"):
+        return self.spawn([PY, PROBE, json.dumps(plan)], name, stdout=subprocess.PIPE, text=True)
+
+    def call(self, service, timeout=20):
+        return subprocess.run(["rosservice", "call", service], env=self.env, capture_output=True, text=True,
+                              timeout=timeout)
+
+    @staticmethod
+    def log(proc):
+        return open(proc.log_path).read() if os.path.exists(proc.log_path) else ""
+
+    def stop(self):
+        for proc in reversed(self.procs):
+            if proc.poll() is None:
+                try:
+                    os.killpg(proc.pid, signal.SIGTERM)
+                except ProcessLookupError:
+                    pass
+        for proc in reversed(self.procs):
+            try:
+                proc.wait(5)
+            except subprocess.TimeoutExpired:
+                os.killpg(proc.pid, signal.SIGKILL)
+                proc.wait(5)
+
+
+@pytest.fixture
+def ros(tmp_path):
+    r = Ros(tmp_path)
+    yield r
+    r.stop()

@@ -1,0 +1,37 @@
+"""launch/monitor.launch included from a robot's launch file, under roslaunch."""
+import os
+import signal
+
+import pytest
+
+from conftest import ROOT
+from rosharness import ros  # noqa: F401
+
+pytestmark = pytest.mark.ros
+
+
+def test_monitor_launch_included_from_another_launch_file(ros, tmp_path):
+    (tmp_path / "lib.yaml").write_text("actions:\n  stop: {plugin: publish, topic: /safety_cmd, "
+                                       "type: geometry_msgs/Twist, message: {}, rate: 20 Hz, latch: true}\n")
+    spec = tmp_path / "safety.rbs"
+    spec.write_text('import "lib.yaml";\naction primitive stop;\n'
+                    "entity base { rules: fast: topic /cmd_vel.linear.x > 1.0 m/s; }\nif (base.fast) then { stop; }\n")
+    bringup = tmp_path / "bringup.launch"
+    bringup.write_text(f"""<launch>
+  <include file="$(find rubass)/launch/monitor.launch">
+    <arg name="spec" value="{spec}"/>
+    <arg name="rate" value="100"/>
+  </include>
+</launch>
+""")
+    ros.env["ROS_PACKAGE_PATH"] = ROOT + os.pathsep + ros.env.get("ROS_PACKAGE_PATH", "/usr/share")
+    launch = ros.spawn(["roslaunch", "--wait", str(bringup)], "roslaunch")
+    ros.wait_service("/rubass/reset", launch, timeout=30)
+    rec = ros.probe({"listen": [{"topic": "/safety_cmd", "type": "geometry_msgs/Twist"}],
+                     "advertise": [{"topic": "/cmd_vel", "type": "geometry_msgs/Twist"}],
+                     "steps": [{"wait_subscribers": "/cmd_vel"}, {"wait_publishers": "/safety_cmd"}, {"sleep": 0.3},
+                               {"publish": "/cmd_vel", "msg": {"linear": {"x": 2.0}}},
+                               {"wait": "/safety_cmd", "timeout": 5}]})
+    assert any(r["kind"] == "recv" for r in rec), ros.log(launch)
+    launch.send_signal(signal.SIGINT)
+    assert launch.wait(20) == 0
