@@ -32,3 +32,16 @@ def shared_path(*parts):
     if not os.path.exists(path):
         pytest.skip(f"{path} is absent (shared/ is only beside the project in development)")
     return path
+
+
+@pytest.fixture
+def ros(tmp_path):
+    """A private rosmaster on a free port for this test, stopped by PID afterwards (see rosharness)."""
+    integration = os.path.join(ROOT, "test", "integration")
+    if integration not in sys.path:
+        sys.path.insert(0, integration)
+    from rosharness import Ros
+
+    r = Ros(tmp_path)
+    yield r
+    r.stop()

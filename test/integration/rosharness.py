@@ -4,7 +4,6 @@ import os
 import signal
 import socket
 import subprocess
-import sys
 import time
 
 import pytest
@@ -115,10 +114,3 @@ class Ros:
             except subprocess.TimeoutExpired:
                 os.killpg(proc.pid, signal.SIGKILL)
                 proc.wait(5)
-
-
-@pytest.fixture
-def ros(tmp_path):
-    r = Ros(tmp_path)
-    yield r
-    r.stop()

@@ -6,7 +6,6 @@ import subprocess
 import pytest
 
 from conftest import ROOT
-from rosharness import ros  # noqa: F401
 
 pytestmark = [pytest.mark.ros, pytest.mark.slow]
 

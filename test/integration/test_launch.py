@@ -5,7 +5,6 @@ import signal
 import pytest
 
 from conftest import ROOT
-from rosharness import ros  # noqa: F401
 
 pytestmark = pytest.mark.ros
 

@@ -7,7 +7,7 @@ import time
 import pytest
 
 from conftest import ROOT
-from rosharness import PY, ros  # noqa: F401  (fixture)
+from rosharness import PY
 
 pytestmark = pytest.mark.ros
 

@@ -1,0 +1,56 @@
+"""Parts of the ROS shell checked directly: the node sampler's verdicts and the topic watcher."""
+import pytest
+
+pytest.importorskip("rospy")
+
+from rubass.engine.values import UNKNOWN  # noqa: E402
+from rubass.lang import check_text  # noqa: E402
+from rubass.ros.nodes import NodeSampler, NodeStatus  # noqa: E402
+
+pytestmark = pytest.mark.ros
+
+
+def test_a_node_on_another_host_is_alive_but_unmeasurable_and_says_why():
+    got = []
+    sampler = NodeSampler([("driver", "/driver")], lambda *a: got.append(a), lambda: 1.0, 0.1, "/rubass")
+    sampler._ask = lambda name: (True, 4242, "alive")
+    sampler._uris["/driver"] = "http://robot-arm-pc.invalid:40000/"
+    st = NodeStatus("driver", "/driver")
+    sampler.sample(st)
+    assert got == [("driver", 1.0, True, UNKNOWN, UNKNOWN)]
+    assert st.why == "on host robot-arm-pc.invalid, not this one: cpu and memory are unknown"
+
+
+def test_a_local_node_is_measured_from_the_second_sample(tmp_path):
+    import os
+
+    got = []
+    sampler = NodeSampler([("me", "/me")], lambda *a: got.append(a), lambda: 1.0, 0.1, "/rubass")
+    sampler._ask = lambda name: (True, os.getpid(), "alive")
+    sampler._uris["/me"] = "http://127.0.0.1:40000/"
+    st = NodeStatus("me", "/me")
+    sampler.sample(st)
+    sampler.sample(st)
+    assert got[0][3] is UNKNOWN and got[0][4] > 1e6  # the first CPU reading only starts the count
+    assert isinstance(got[1][3], float) and got[1][4] > 1e6
+
+
+def test_topics_read_only_by_age_are_never_deserialised():
+    import rospy
+
+    from rubass.ros.topics import TopicWatcher
+
+    rospy.rostime.set_rostime_initialized(True)
+    spec = check_text("entity a { rules: r: age(topic /blob) > 1 s; }\n", "/tmp/x.rbs")
+    got = []
+    watcher = TopicWatcher(lambda *a: got.append(a), lambda level, text: got.append(("log", text)))
+    watcher.topics["/blob"] = state = __import__("rubass.ros.topics", fromlist=["TopicState"]).TopicState(
+        "/blob", "/blob", {})
+    assert spec.topics["/blob"].needs_data is False
+
+    class Raw:
+        _buff = b"\xff\x00 not a message at all"
+        _connection_header = {"type": "weird/Type", "md5sum": "0" * 32, "message_definition": "garbage !!"}
+
+    watcher._callback(Raw(), state)
+    assert len(got) == 1 and got[0][0] == "/blob" and got[0][2] is None and state.cls is None
