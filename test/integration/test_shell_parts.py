@@ -54,3 +54,32 @@ def test_topics_read_only_by_age_are_never_deserialised():
 
     watcher._callback(Raw(), state)
     assert len(got) == 1 and got[0][0] == "/blob" and got[0][2] is None and state.cls is None
+
+
+def test_a_topic_that_changes_type_is_reported_and_its_fields_rechecked():
+    import io
+
+    import rospy
+    from std_msgs.msg import Float64, String
+
+    from rubass.ros.topics import TopicState, TopicWatcher, field_users
+
+    rospy.rostime.set_rostime_initialized(True)
+    spec = check_text("entity a { rules: r: topic /x.data > 1; }\n", "/tmp/x.rbs")
+    got, logs = [], []
+    watcher = TopicWatcher(lambda *a: got.append(a), lambda level, text: logs.append(text))
+    state = TopicState("/x", "/x", field_users(spec)["/x"])
+
+    def raw(msg):
+        buf = io.BytesIO()
+        msg.serialize(buf)
+        r = type("Raw", (), {})()
+        r._buff = buf.getvalue()
+        r._connection_header = {"type": msg._type, "md5sum": msg._md5sum, "message_definition": msg._full_text}
+        return r
+
+    watcher._callback(raw(Float64(5.0)), state)
+    watcher._callback(raw(String("five")), state)
+    assert got[0][2].data == 5.0 and got[1][2].data == "five"
+    assert "topic /x changed type from std_msgs/Float64 to std_msgs/String" in logs
+    assert state.type == "std_msgs/String" and "changed type from std_msgs/Float64 to std_msgs/String" in state.errors
