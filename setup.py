@@ -8,5 +8,6 @@ except ImportError:  # plain setuptools, outside a catkin build
         return kwargs
 
 setup(**generate_distutils_setup(
-    packages=["rubass", "rubass.lang", "rubass.engine", "rubass.replay", "rubass.ros", "rubass.ros.actions"],
+    packages=["rubass", "rubass.lang", "rubass.engine", "rubass.replay", "rubass.ros", "rubass.ros.actions",
+              "rubass.ros.sim", "rubass.sim"],
 ))

@@ -95,7 +95,7 @@ def _register_replay(sub: "argparse._SubParsersAction[argparse.ArgumentParser]")
 
 def _register_experiments(sub: "argparse._SubParsersAction[argparse.ArgumentParser]") -> None:
     try:
-        from .sim.experiments_command import register
+        from .ros.sim.command import register
     except ImportError:
         return
     register(sub)

@@ -75,9 +75,10 @@ def run(args: argparse.Namespace) -> int:
             if name not in info.types:
                 print(f"rubass replay: warning: topic {name} is not in {args.bag}; its values stay unknown",
                       file=sys.stderr)
-        if spec.nodes:
-            print("rubass replay: warning: a recording has no node samples; alive(), cpu() and memory() "
-                  "stay unknown", file=sys.stderr)
+        node_topics = sorted(t for t, ty in info.types.items() if t.endswith("/node_samples") and ty == "std_msgs/String")
+        if spec.nodes and not node_topics:
+            print("rubass replay: warning: the recording has no node samples (a monitor's ~node_samples); "
+                  "alive(), cpu() and memory() stay unknown", file=sys.stderr)
         present = [t for t in topic_map if t in info.types]
         decode: Set[str] = {t for t in present if spec.topics[topic_map[t]].needs_data}
         classes = message_classes(bag, sorted(decode))
@@ -94,9 +95,11 @@ def run(args: argparse.Namespace) -> int:
             return 1
         from .run import replay
 
-        stream = ((t, topic_map[topic], msg) for t, topic, msg in read(bag, present, decode))
+        node_topics = node_topics if spec.nodes else []
+        stream = ((t, topic_map.get(topic, topic), msg)
+                  for t, topic, msg in read(bag, present + node_topics, decode | set(node_topics)))
         try:
-            _, events = replay(spec, stream, info.start, info.end, args.rate)
+            _, events = replay(spec, stream, info.start, info.end, args.rate, node_topics)
         except BagError as exc:
             print(f"rubass replay: error: {exc}", file=sys.stderr)
             return 1

@@ -2,15 +2,21 @@
 messages that share a timestamp evaluated together. Pure: the recording is any iterable."""
 from __future__ import annotations
 
+import json
 from typing import Any, Iterable, List, Optional, Tuple
 
-from ..engine import Engine, Event
+from ..engine import UNKNOWN, Engine, Event
 from ..lang.model import CheckedSpec
 
 
 def replay(spec: CheckedSpec, messages: Iterable[Tuple[float, str, Optional[Any]]], start: float, end: float,
-           rate: float = 50.0) -> Tuple[Engine, List[Event]]:
-    """Events with times in seconds since `start`; every spec topic is watched from `start`."""
+           rate: float = 50.0, node_topics: Iterable[str] = ()) -> Tuple[Engine, List[Event]]:
+    """Events with times in seconds since `start`; every spec topic is watched from `start`.
+
+    Messages on `node_topics` are the monitor's recorded node samples (JSON with node, alive,
+    cpu, memory), fed to the engine as samples.
+    """
+    node_topics = set(node_topics)
     engine = Engine(spec, 0.0)
     events = engine.evaluate_all(0.0)
     period = 1.0 / rate
@@ -31,6 +37,13 @@ def replay(spec: CheckedSpec, messages: Iterable[Tuple[float, str, Optional[Any]
 
     for stamp, topic, msg in messages:
         t = stamp - start
+        if topic in node_topics:
+            flush()
+            ticks_until(t, inclusive=False)
+            sample = _node_sample(msg)
+            if sample is not None:
+                events.extend(engine.on_node_sample(sample[0], t, *sample[1:]))
+            continue
         if batch and t != batch_time:
             flush()
         if not batch:
@@ -41,3 +54,18 @@ def replay(spec: CheckedSpec, messages: Iterable[Tuple[float, str, Optional[Any]
     ticks_until(end - start, inclusive=True)
     events.extend(engine.advance(end - start))
     return engine, events
+
+
+def _node_sample(msg: Any) -> Optional[Tuple[str, Any, Any, Any]]:
+    """(node, alive, cpu, memory) from a recorded ~node_samples message; None if unreadable."""
+    try:
+        d = json.loads(msg.data)
+        return (str(d["node"]), _known(d.get("alive")), _known(d.get("cpu")), _known(d.get("memory")))
+    except (ValueError, KeyError, TypeError, AttributeError):
+        return None
+
+
+def _known(v: Any) -> Any:
+    if v is True or v is False:
+        return v
+    return float(v) if isinstance(v, (int, float)) else UNKNOWN

@@ -14,6 +14,7 @@ Publishes
     /diagnostics (diagnostic_msgs/DiagnosticArray)  one status per entity, one for the monitor
     ~events (std_msgs/String)     one JSON object per behaviour start and release (docs/monitor.md)
     ~heartbeat (std_msgs/Header)  at the tick rate, from the engine's thread
+    ~node_samples (std_msgs/String)  each node sample as JSON, so that recordings can replay them
     and whatever the spec's publish actions publish
 Services
     ~reload (std_srvs/Trigger)    re-read spec and libraries; a broken spec is rejected
@@ -137,6 +138,7 @@ class Monitor:
 
     def _on_node(self, node: str, now: float, alive: Any, cpu: Any, memory: Any) -> None:
         self.loop.submit(NodeSample(node, now, alive, cpu, memory))
+        self.outputs.node_sample(node, now, alive, cpu, memory)
 
     # -- running -------------------------------------------------------------------------
     def run(self) -> None:

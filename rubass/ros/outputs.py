@@ -17,6 +17,7 @@ class Outputs:
         self.events = rospy.Publisher("~events", String, queue_size=1000, tcp_nodelay=True)
         self.heartbeat = rospy.Publisher("~heartbeat", Header, queue_size=1, tcp_nodelay=True)
         self.diagnostics = rospy.Publisher("/diagnostics", DiagnosticArray, queue_size=5)
+        self.node_samples = rospy.Publisher("~node_samples", String, queue_size=100, tcp_nodelay=True)
         self._seq = 0
         self._hw = socket.gethostname()
 
@@ -28,6 +29,12 @@ class Outputs:
     def event(self, record: Dict[str, Any]) -> None:
         self.events.publish(String(data=json.dumps(record, sort_keys=True)))
 
+    def node_sample(self, node: str, now: float, alive: Any, cpu: Any, memory: Any) -> None:
+        """A node sample as JSON, so that recordings carry them (rubass replay uses them)."""
+        known = lambda v: v if isinstance(v, (bool, float)) else None  # noqa: E731
+        self.node_samples.publish(String(data=json.dumps(
+            {"node": node, "time": now, "alive": known(alive), "cpu": known(cpu), "memory": known(memory)})))
+
     def status(self, entries: List[Entry], now: float) -> None:
         arr = DiagnosticArray()
         arr.header.stamp = rospy.Time.from_sec(now)
@@ -38,5 +45,5 @@ class Outputs:
         self.diagnostics.publish(arr)
 
     def close(self) -> None:
-        for pub in (self.events, self.heartbeat, self.diagnostics):
+        for pub in (self.events, self.heartbeat, self.diagnostics, self.node_samples):
             pub.unregister()

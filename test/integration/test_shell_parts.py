@@ -24,6 +24,7 @@ def test_a_node_on_another_host_is_alive_but_unmeasurable_and_says_why():
 def test_a_local_node_is_measured_from_the_second_sample(tmp_path):
     import os
 
+
     got = []
     sampler = NodeSampler([("me", "/me")], lambda *a: got.append(a), lambda: 1.0, 0.1, "/rubass")
     sampler._ask = lambda name: (True, os.getpid(), "alive")
@@ -33,6 +34,29 @@ def test_a_local_node_is_measured_from_the_second_sample(tmp_path):
     sampler.sample(st)
     assert got[0][3] is UNKNOWN and got[0][4] > 1e6  # the first CPU reading only starts the count
     assert isinstance(got[1][3], float) and got[1][4] > 1e6
+
+
+def test_cpu_of_a_busy_process_is_not_quantized_to_ten_percent_steps():
+    import subprocess
+    import sys
+    import time
+
+    busy = subprocess.Popen([sys.executable, "-c", "while True: pass"])
+    try:
+        got = []
+        sampler = NodeSampler([("b", "/b")], lambda *a: got.append(a[3]), lambda: 1.0, 0.1, "/rubass")
+        sampler._ask = lambda name: (True, busy.pid, "alive")
+        sampler._uris["/b"] = "http://127.0.0.1:40000/"
+        st = NodeStatus("b", "/b")
+        for _ in range(12):
+            sampler.sample(st)
+            time.sleep(0.1)
+        shares = got[1:]
+        assert all(0.9 < s < 1.1 for s in shares), shares
+        assert len({round(s, 3) for s in shares}) > 3, "nanosecond run times, not 10 % steps"
+    finally:
+        busy.kill()
+        busy.wait()
 
 
 def test_topics_read_only_by_age_are_never_deserialised():

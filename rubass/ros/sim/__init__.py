@@ -1,0 +1,1 @@
+"""The simulated robots, the fault injector and the experiment runner (ROS nodes)."""

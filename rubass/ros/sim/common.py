@@ -1,0 +1,36 @@
+"""What the simulated nodes share: reading faults, publishing odometry."""
+from __future__ import annotations
+
+import json
+import math
+from typing import Any, Callable, Dict
+
+import rospy
+from nav_msgs.msg import Odometry
+from std_msgs.msg import String
+
+from ...sim.kinematics import DiffDrive
+
+FAULT_TOPIC = "/sim/fault"
+
+
+def on_fault(handler: Callable[[Dict[str, Any]], None]) -> rospy.Subscriber:
+    """Subscribe to the runner's fault commands (JSON in std_msgs/String)."""
+    return rospy.Subscriber(FAULT_TOPIC, String, lambda m: handler(json.loads(m.data)), tcp_nodelay=True)
+
+
+def odometry(base: DiffDrive, stamp: rospy.Time) -> Odometry:
+    msg = Odometry()
+    msg.header.stamp = stamp
+    msg.header.frame_id = "odom"
+    msg.child_frame_id = "base_link"
+    msg.pose.pose.position.x, msg.pose.pose.position.y = base.x, base.y
+    msg.pose.pose.orientation.z, msg.pose.pose.orientation.w = math.sin(base.yaw / 2), math.cos(base.yaw / 2)
+    v, w = base.body()
+    msg.twist.twist.linear.x, msg.twist.twist.angular.z = v, w
+    return msg
+
+
+def yaw_of(msg: Odometry) -> float:
+    q = msg.pose.pose.orientation
+    return math.atan2(2.0 * (q.w * q.z + q.x * q.y), 1.0 - 2.0 * (q.y * q.y + q.z * q.z))

@@ -1,0 +1,283 @@
+"""The experiment runner: every row of the paper's Table 1 on the simulated robots, N times.
+
+Each run starts its own processes (base, driver, fault injector, the monitor, rosbag record)
+on the runner's master, lets the robot drive, injects the fault, and waits for the stop to
+reach the base. The nodes log wall-clock events to one file per run, from which:
+(a) the paper's time: from the row's origin (the fault, the first command over the limit,
+    the crossing of the border, the start of the CPU loop) to the stop reaching the base;
+(b) the monitor's own delay: from the instant its rule became due, computed afterwards by
+    replaying the run's bag through the same engine, to the stop reaching the base.
+"""
+from __future__ import annotations
+
+import json
+import os
+import shutil
+import signal
+import socket
+import subprocess
+import sys
+import time
+import uuid
+from dataclasses import asdict, dataclass, field
+from typing import Any, Dict, List, Optional
+
+from ...lang import load_spec
+from ...replay.run import replay
+from ...sim.rows import Row
+from ..bag import BagError, open_bag, read
+from .eventlog import read_events
+
+PY = "/usr/bin/python3"
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))))
+CONFIG = os.path.join(ROOT, "config")
+WARMUP = 1.5        # seconds of normal driving before the fault
+STOP_TIMEOUT = 25.0  # seconds after the fault to wait for the stop
+
+
+@dataclass
+class RunResult:
+    row: str
+    rep: int
+    stopped: bool
+    a: Optional[float] = None        # seconds, the paper's definition
+    b: Optional[float] = None        # seconds, the monitor's own delay
+    due_source: str = ""
+    error: str = ""
+    bag: str = ""
+    events: List[Dict[str, Any]] = field(default_factory=list)
+
+
+class Session:
+    """A private rosmaster for the whole experiment, and this process as a ROS node."""
+
+    def __init__(self, out: str) -> None:
+        self.out = out
+        with socket.socket() as s:
+            s.bind(("127.0.0.1", 0))
+            self.port = s.getsockname()[1]
+        self.env = dict(os.environ, ROS_MASTER_URI=f"http://127.0.0.1:{self.port}", ROS_IP="127.0.0.1",
+                        ROS_HOME=os.path.join(out, "ros_home"), PYTHONPATH=ROOT + os.pathsep + os.environ.get("PYTHONPATH", ""),
+                        PYTHONDONTWRITEBYTECODE="1")
+        self.env.pop("ROS_HOSTNAME", None)
+        os.makedirs(self.env["ROS_HOME"], exist_ok=True)
+        self.master = subprocess.Popen(["rosmaster", "--core", "-p", str(self.port)], env=self.env,
+                                       stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True)
+        os.environ.update({k: self.env[k] for k in ("ROS_MASTER_URI", "ROS_IP", "ROS_HOME")})
+        import rosgraph
+
+        end = time.time() + 10
+        while not rosgraph.is_master_online(self.env["ROS_MASTER_URI"]):
+            if time.time() > end:
+                raise RuntimeError("rosmaster did not start")
+            time.sleep(0.05)
+        rosgraph.Master("/rubass_experiments").setParam("/run_id", str(uuid.uuid1()))
+        import rospy
+        from std_msgs.msg import String
+
+        rospy.init_node("rubass_experiments", disable_signals=True)
+        self.faults = rospy.Publisher("/sim/fault", String, queue_size=10, tcp_nodelay=True)
+
+    def close(self) -> None:
+        import rospy
+
+        rospy.signal_shutdown("experiments done")
+        _stop([self.master])
+
+
+def _stop(procs: List[subprocess.Popen], sig: int = signal.SIGTERM) -> None:
+    for p in procs:
+        if p.poll() is None:
+            try:
+                os.killpg(p.pid, sig)
+            except ProcessLookupError:
+                pass
+    for p in procs:
+        try:
+            p.wait(5)
+        except subprocess.TimeoutExpired:
+            os.killpg(p.pid, signal.SIGKILL)
+            p.wait(5)
+
+
+def _spec_for(row: Row, run_dir: str) -> str:
+    """The spec the monitor runs: config/ as it is, but the Frobit board on this run's pty."""
+    if row.robot != "frobit":
+        return os.path.join(CONFIG, row.spec)
+    shutil.copy(os.path.join(CONFIG, row.spec), run_dir)
+    with open(os.path.join(CONFIG, "frobit_actions.yaml")) as fh:
+        lib = fh.read().replace("/dev/ttyACM0", os.path.join(run_dir, "board"))
+    with open(os.path.join(run_dir, "frobit_actions.yaml"), "w") as fh:
+        fh.write(lib)
+    return os.path.join(run_dir, row.spec)
+
+
+def _bag_topics(row: Row) -> List[str]:
+    if row.robot == "kobuki":
+        return ["/mobile_base/commands/velocity", "/odom", "/cmd_vel", "/mobile_base/commands/safety_velocity",
+                "/rubass/events", "/rubass/node_samples", "/sim/fault"]
+    return ["/wheel_left/cmd", "/wheel_right/cmd", "/wheel_left/encoder", "/wheel_right/encoder", "/odom",
+            "/wheel_left/safety_cmd", "/wheel_right/safety_cmd", "/rubass/events", "/sim/fault"]
+
+
+def run_once(session: Session, row: Row, rep: int) -> RunResult:
+    run_dir = os.path.join(session.out, "runs", row.name.replace(" ", "_").replace("(", "").replace(")", ""), str(rep))
+    shutil.rmtree(run_dir, ignore_errors=True)
+    os.makedirs(run_dir)
+    events_file = os.path.join(run_dir, "events.jsonl")
+    spec_path = _spec_for(row, run_dir)
+    procs: List[subprocess.Popen] = []
+
+    def spawn(name: str, args: List[str]) -> subprocess.Popen:
+        log = open(os.path.join(run_dir, f"{name}.log"), "w")
+        p = subprocess.Popen(args, env=session.env, stdout=log, stderr=subprocess.STDOUT, cwd=run_dir,
+                             start_new_session=True)
+        procs.append(p)
+        return p
+
+    ev = f"_events_file:={events_file}"
+    if row.robot == "kobuki":
+        spawn("base", [PY, "-m", "rubass.ros.sim.kobuki", "__name:=mobile_base", ev])
+        spawn("injector", [PY, "-m", "rubass.ros.sim.injector", "__name:=fault_injector", ev])
+        spawn("driver", [PY, "-m", "rubass.ros.sim.driver", "__name:=controller", "_robot:=kobuki", ev,
+                         "_goal_x:=2.5", "_goal_y:=1.0"])
+    else:
+        spawn("base", [PY, "-m", "rubass.ros.sim.frobit", "__name:=frobit_base", ev,
+                       f"_board_port:={os.path.join(run_dir, 'board')}", f"_seed:={rep}"])
+        spawn("driver", [PY, "-m", "rubass.ros.sim.driver", "__name:=controller", "_robot:=frobit", ev,
+                         "_goal_x:=4.0", "_goal_y:=1.0"])
+    bag = os.path.join(run_dir, "run.bag")
+    recorder = spawn("rosbag", ["rosbag", "record", "--tcpnodelay", "-O", bag] + _bag_topics(row))
+    result = RunResult(row.name, rep, False, bag=bag)
+    try:
+        if row.robot == "frobit":
+            _wait(lambda: os.path.lexists(os.path.join(run_dir, "board")), 15, "the safety board's port")
+        monitor = spawn("monitor", [PY, os.path.join(ROOT, "scripts", "monitor"), "__name:=rubass",
+                                    f"_spec:={spec_path}", "_node_rate:=10"])
+        _wait_service("/rubass/reset", monitor, 30)
+        expected = 3 if row.robot == "kobuki" else 2  # the nodes that listen to /sim/fault
+        _wait(lambda: session.faults.get_num_connections() >= expected, 15, "the simulated nodes")
+        time.sleep(WARMUP)
+        if any(e["event"] == "stop_received" for e in read_events(events_file)):
+            result.error = "stopped before the fault (a false positive)"
+            return result
+        session.faults.publish(json.dumps(row.fault))
+        fault_sent = time.time()
+        end = fault_sent + STOP_TIMEOUT
+        while time.time() < end and not any(e["event"] == "stop_received" for e in read_events(events_file)):
+            time.sleep(0.01)
+        time.sleep(0.3)  # let the recorder catch the last messages
+        _stop([recorder], signal.SIGINT)
+        # rosbag's recorder (a child process) renames run.bag.active to run.bag after its parent exits
+        _wait(lambda: os.path.exists(bag) and not os.path.exists(bag + ".active"), 15, "the bag")
+        result.events = read_events(events_file)
+        _measure(row, result, spec_path, fault_sent)
+    except Exception as exc:  # a run that breaks is reported, and the others go on
+        result.error = f"{exc.__class__.__name__}: {exc}"
+    finally:
+        _stop([p for p in procs if p is not recorder])
+        _stop([recorder], signal.SIGINT)
+    return result
+
+
+def _wait(cond: Any, timeout: float, what: str) -> None:
+    end = time.time() + timeout
+    while not cond():
+        if time.time() > end:
+            raise RuntimeError(f"{what} did not come up within {timeout:g} s")
+        time.sleep(0.02)
+
+
+def _wait_service(name: str, proc: subprocess.Popen, timeout: float) -> None:
+    import rosgraph
+
+    master = rosgraph.Master("/rubass_experiments")
+
+    def up() -> bool:
+        if proc.poll() is not None:
+            raise RuntimeError(f"the monitor exited with {proc.returncode}")
+        try:
+            master.lookupService(name)
+            return True
+        except rosgraph.MasterError:
+            return False
+
+    _wait(up, timeout, "the monitor")
+
+
+def _first(events: List[Dict[str, Any]], name: str, after: float = 0.0) -> Optional[float]:
+    times = [e["wall"] for e in events if e["event"] == name and e["wall"] >= after]
+    return min(times) if times else None
+
+
+def _measure(row: Row, result: RunResult, spec_path: str, fault_sent: float) -> None:
+    stop = _first(result.events, "stop_received")
+    if stop is None:
+        result.error = f"no stop within {STOP_TIMEOUT:g} s of the fault"
+        return
+    result.stopped = True
+    origin = _first(result.events, row.origin, fault_sent - 1.0)
+    if origin is None:
+        result.error = f"no '{row.origin}' event"
+        return
+    result.a = stop - origin
+    due = _due_from_bag(spec_path, result.bag, fault_sent)
+    result.due_source = "replay of the run's bag (with the monitor's node samples)"
+    if due is None:
+        result.error = "the replay of the bag found no behaviour start"
+        return
+    result.b = stop - due
+
+
+def _due_from_bag(spec_path: str, bag_path: str, after: float) -> Optional[float]:
+    """The first behaviour start after `after`, as the engine computes it from the recording."""
+    spec = load_spec(spec_path)
+    try:
+        bag, info = open_bag(bag_path)
+    except BagError:
+        return None
+    with bag:
+        topics = [t for t in spec.topics if t in info.types]
+        nodes = ["/rubass/node_samples"] if "/rubass/node_samples" in info.types else []
+        decode = {t for t in topics if spec.topics[t].needs_data} | set(nodes)
+        _, events = replay(spec, read(bag, topics + nodes, decode), info.start, info.end, node_topics=nodes)
+    starts = [info.start + e.time for e in events if e.kind == "start" and info.start + e.time >= after - 0.5]
+    return min(starts) if starts else None
+
+
+def results_json(rows: List[Row], results: List[RunResult]) -> Dict[str, Any]:
+    from ...sim.rows import stats
+
+    out: Dict[str, Any] = {"rows": []}
+    for r in rows:
+        runs = [x for x in results if x.row == r.name]
+        sa = stats([x.a for x in runs if x.a is not None])
+        sb = stats([x.b for x in runs if x.b is not None])
+        out["rows"].append({
+            "row": r.name, "robot": r.robot, "spec": r.spec, "ideal": r.ideal, "note": r.note,
+            "paper": dict(zip(("avg", "sd", "min", "max"), r.paper)),
+            "a": asdict(sa) if sa else None, "b": asdict(sb) if sb else None,
+            "runs": len(runs), "stopped": sum(x.stopped for x in runs),
+            "errors": [x.error for x in runs if x.error],
+            "details": [{k: v for k, v in asdict(x).items() if k != "events"} for x in runs],
+        })
+    return out
+
+
+def main_loop(rows: List[Row], reps: int, out: str, progress: Any = sys.stderr) -> List[RunResult]:
+    os.makedirs(out, exist_ok=True)
+    session = Session(out)
+    results: List[RunResult] = []
+    try:
+        for r in rows:
+            for rep in range(reps):
+                res = run_once(session, r, rep)
+                results.append(res)
+                a = f"{res.a:.3f} s" if res.a is not None else "-"
+                b = f"{res.b * 1000:.1f} ms" if res.b is not None else "-"
+                progress.write(f"  {r.name:<13} run {rep + 1}/{reps}: stopped={res.stopped} (a) {a} (b) {b}"
+                               f"{'  ' + res.error if res.error else ''}\n")
+                progress.flush()
+    finally:
+        session.close()
+    return results
