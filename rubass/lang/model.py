@@ -78,6 +78,22 @@ class CheckedSpec:
     warnings: List[Diagnostic] = field(default_factory=list)
     sources: SourceSet = field(default_factory=SourceSet)
 
+    def field_readers(self) -> Dict[str, Dict[Tuple[ast.PathElem, ...], List[str]]]:
+        """topic -> field path -> who reads it ("rule 'e.r'", "behaviour 2 (line 9)"), for errors."""
+        out: Dict[str, Dict[Tuple[ast.PathElem, ...], List[str]]] = {t: {} for t in self.topics}
+        owners = [(f"rule '{r.key}'", r.expr) for r in self.rules] + \
+                 [(f"behaviour {b.index} (line {b.span.line})", b.cond) for b in self.behaviours]
+        for owner, expr in owners:
+            stack = [expr]
+            while stack:
+                e = stack.pop()
+                stack.extend(ast.children(e))
+                if isinstance(e, ast.TopicRef) and e.path:
+                    users = out[e.topic].setdefault(e.path, [])
+                    if owner not in users:
+                        users.append(owner)
+        return out
+
     def rule(self, key: str) -> CheckedRule:
         for r in self.rules:
             if r.key == key:

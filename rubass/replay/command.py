@@ -3,10 +3,9 @@ from __future__ import annotations
 
 import argparse
 import sys
-from typing import Dict, List, Set, Tuple
+from typing import Set
 
-from ..lang import SpecError, ast, load_spec
-from ..lang.model import CheckedSpec
+from ..lang import SpecError, load_spec
 from . import report
 
 
@@ -38,23 +37,6 @@ def _global(name: str) -> str:
     return name if name.startswith("/") else "/" + name.lstrip("~")
 
 
-def _field_uses(spec: CheckedSpec) -> Dict[Tuple[str, Tuple[ast.PathElem, ...]], List[str]]:
-    """(topic, path) -> the rules (or behaviours) that read it."""
-    uses: Dict[Tuple[str, Tuple[ast.PathElem, ...]], List[str]] = {}
-    owners = [(f"rule '{r.key}'", r.expr) for r in spec.rules] + \
-             [(f"behaviour {b.index} (line {b.span.line})", b.cond) for b in spec.behaviours]
-    for owner, expr in owners:
-        stack = [expr]
-        while stack:
-            e = stack.pop()
-            stack.extend(ast.children(e))
-            if isinstance(e, ast.TopicRef) and e.path:
-                users = uses.setdefault((e.topic, e.path), [])
-                if owner not in users:
-                    users.append(owner)
-    return uses
-
-
 def run(args: argparse.Namespace) -> int:
     try:
         spec = load_spec(args.spec, args.actions)
@@ -83,7 +65,8 @@ def run(args: argparse.Namespace) -> int:
         decode: Set[str] = {t for t in present if spec.topics[topic_map[t]].needs_data}
         classes = message_classes(bag, sorted(decode))
         errors = []
-        for (topic, path), owners in sorted(_field_uses(spec).items(), key=str):
+        readers = [((t, p), owners) for t, paths in spec.field_readers().items() for p, owners in paths.items()]
+        for (topic, path), owners in sorted(readers, key=str):
             cls = classes.get(_global(topic))
             problem = check_path(cls, path) if cls is not None else None
             if problem:

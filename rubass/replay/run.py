@@ -42,7 +42,9 @@ def replay(spec: CheckedSpec, messages: Iterable[Tuple[float, str, Optional[Any]
             ticks_until(t, inclusive=False)
             sample = _node_sample(msg)
             if sample is not None:
-                events.extend(engine.on_node_sample(sample[0], t, *sample[1:]))
+                # at the instant the monitor took it (recorded in the sample), as the live engine did
+                at = max(min(t, sample[4] - start), engine.store.now) if sample[4] is not None else t
+                events.extend(engine.on_node_sample(sample[0], at, *sample[1:4]))
             continue
         if batch and t != batch_time:
             flush()
@@ -56,11 +58,13 @@ def replay(spec: CheckedSpec, messages: Iterable[Tuple[float, str, Optional[Any]
     return engine, events
 
 
-def _node_sample(msg: Any) -> Optional[Tuple[str, Any, Any, Any]]:
-    """(node, alive, cpu, memory) from a recorded ~node_samples message; None if unreadable."""
+def _node_sample(msg: Any) -> Optional[Tuple[str, Any, Any, Any, Optional[float]]]:
+    """(node, alive, cpu, memory, sample time) from a recorded ~node_samples message; None if unreadable."""
     try:
         d = json.loads(msg.data)
-        return (str(d["node"]), _known(d.get("alive")), _known(d.get("cpu")), _known(d.get("memory")))
+        at = d.get("time")
+        return (str(d["node"]), _known(d.get("alive")), _known(d.get("cpu")), _known(d.get("memory")),
+                float(at) if isinstance(at, (int, float)) else None)
     except (ValueError, KeyError, TypeError, AttributeError):
         return None
 

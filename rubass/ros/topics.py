@@ -40,19 +40,7 @@ class TopicState:
 
 def field_users(spec: CheckedSpec) -> Dict[str, Dict[Tuple[ast.PathElem, ...], List[str]]]:
     """topic -> field path -> the rules and behaviours that read it."""
-    out: Dict[str, Dict[Tuple[ast.PathElem, ...], List[str]]] = {t: {} for t in spec.topics}
-    owners = [(f"rule '{r.key}'", r.expr) for r in spec.rules] + \
-             [(f"behaviour {b.index} (line {b.span.line})", b.cond) for b in spec.behaviours]
-    for owner, expr in owners:
-        stack = [expr]
-        while stack:
-            e = stack.pop()
-            stack.extend(ast.children(e))
-            if isinstance(e, ast.TopicRef) and e.path:
-                users = out[e.topic].setdefault(e.path, [])
-                if owner not in users:
-                    users.append(owner)
-    return out
+    return spec.field_readers()
 
 
 class TopicWatcher:

@@ -7,6 +7,13 @@ from dataclasses import dataclass
 from typing import Optional
 
 
+# Chance per encoder reading (20 Hz) of a burst of noise from a half-broken quadrature line.
+# Calibrated so that a monitor with no delay of its own reacts to the paper's E rows in about
+# the paper's average time (the paper does not describe its noise): each burst restarts the
+# rule's `for 0.4 s`, so this rate, not the monitor, sets those rows' reaction times.
+NOISE_RATE = 0.02
+
+
 @dataclass
 class WheelFault:
     """Hardware faults of one wheel of the Frobit-like base (paper §4.1)."""
@@ -31,7 +38,7 @@ class WheelFault:
         a burst of noise from the line that still works (the paper's E rows)."""
         if not self.encoder_dead:
             return actual + rng.gauss(0.0, 0.002)
-        if rng.random() < 0.05:
+        if rng.random() < NOISE_RATE:
             return rng.choice((-1.0, 1.0)) * rng.uniform(0.03, 0.08)
         return 0.0
 

@@ -42,7 +42,7 @@ ROWS: List[Row] = [
         (0.17, 0.03, 0.12, 0.21)),
     Row("Spin (0 s)", "kobuki", "kobuki_spin_0s.rbs", {"drift": "angular", "rate": 2.0}, "limit_exceeded", 0.00,
         (0.17, 0.04, 0.11, 0.22)),
-    Row("CPU", "kobuki", "kobuki.rbs", {"cpu_hog": 4.0}, "cpu_hog_start", 1.50, (1.71, 0.14, 1.51, 1.95),
+    Row("CPU", "kobuki", "kobuki.rbs", {"cpu_hog": 8.0, "threads": 2}, "cpu_hog_start", 1.50, (1.71, 0.14, 1.51, 1.95),
         note="(a) includes the node sampling period (10 Hz) and any CPU the loop is denied"),
 ]
 

@@ -10,6 +10,17 @@ import rospy
 from .base import ActionPlugin, ActionSetupError, Context
 
 
+def ros_class(lookup: Any, type_name: str, where: str, kind: str) -> Any:
+    """A message or service class by its 'package/Type' name; ActionSetupError if unknown."""
+    try:
+        cls = lookup(type_name)
+    except Exception:  # roslib raises ValueError, ImportError, … for a bad or missing package
+        cls = None
+    if cls is None:
+        raise ActionSetupError(f"{where}: unknown {kind} type '{type_name}' (is its package installed?)")
+    return cls
+
+
 def build_message(cls: Any, fields: Dict[str, Any], where: str) -> Any:
     """A message of class cls with the YAML field values; ActionSetupError naming the field."""
     msg = cls()  # every field zero, empty or false
@@ -34,14 +45,7 @@ class PublishPlugin(ActionPlugin):
         self.pub: Optional[rospy.Publisher] = None
 
     def setup(self) -> None:
-        type_name = self.params["type"]
-        try:
-            cls = roslib.message.get_message_class(type_name)
-        except Exception:
-            cls = None
-        if cls is None:
-            raise ActionSetupError(f"action '{self.name}': unknown message type '{type_name}' "
-                                   f"(is its package installed?)")
+        cls = ros_class(roslib.message.get_message_class, self.params["type"], f"action '{self.name}'", "message")
         self.msg = build_message(cls, self.params.get("message") or {}, f"action '{self.name}': message")
         release = self.params.get("on_release")
         self.release_msg = None if release is None else build_message(cls, release, f"action '{self.name}': on_release")

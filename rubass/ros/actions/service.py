@@ -7,20 +7,13 @@ from typing import Any, List
 import roslib.message
 import rospy
 
-from .base import ActionPlugin, ActionSetupError, Context
-from .publish import build_message
+from .base import ActionPlugin, Context
+from .publish import build_message, ros_class
 
 
 class ServicePlugin(ActionPlugin):
     def setup(self) -> None:
-        type_name = self.params["type"]
-        try:
-            cls = roslib.message.get_service_class(type_name)
-        except Exception:
-            cls = None
-        if cls is None:
-            raise ActionSetupError(f"action '{self.name}': unknown service type '{type_name}' "
-                                   f"(is its package installed?)")
+        cls = ros_class(roslib.message.get_service_class, self.params["type"], f"action '{self.name}'", "service")
         self.request = build_message(cls._request_class, self.params.get("request") or {},
                                      f"action '{self.name}': request")
         self.proxy = rospy.ServiceProxy(self.params["service"], cls)

@@ -34,3 +34,14 @@ def odometry(base: DiffDrive, stamp: rospy.Time) -> Odometry:
 def yaw_of(msg: Odometry) -> float:
     q = msg.pose.pose.orientation
     return math.atan2(2.0 * (q.w * q.z + q.x * q.y), 1.0 - 2.0 * (q.y * q.y + q.z * q.z))
+
+
+def loop(hz: float, step: Callable[[], None]) -> None:
+    """Call step() hz times a second until ROS shuts down."""
+    rate = rospy.Rate(hz)
+    while not rospy.is_shutdown():
+        step()
+        try:
+            rate.sleep()
+        except rospy.ROSInterruptException:
+            break

@@ -18,7 +18,7 @@ from nav_msgs.msg import Odometry
 from std_msgs.msg import Float64
 
 from ...sim.kinematics import DiffDrive, go_to_goal
-from .common import on_fault, yaw_of
+from .common import loop, on_fault, yaw_of
 from .eventlog import EventLog
 
 
@@ -33,11 +33,9 @@ def main() -> None:
     def odom(msg: Odometry) -> None:
         pose.update(x=msg.pose.pose.position.x, y=msg.pose.pose.position.y, yaw=yaw_of(msg), seen=True)
 
-    def hog(seconds: float) -> None:
+    def hog(seconds: float, end: float) -> None:
         """A CPU-bound loop in native code (hashing releases the GIL), as a stuck computation
-        in a real controller would be: it takes a whole core, whatever the node's other threads do."""
-        log.log("cpu_hog_start", seconds=seconds)
-        end = time.monotonic() + seconds
+        in a real controller would be: it takes a core, whatever the node's other threads do."""
         block = b"\0" * (1 << 20)
         while time.monotonic() < end:
             hashlib.sha256(block).digest()
@@ -47,7 +45,10 @@ def main() -> None:
             goal[:] = f["goal"]
             log.log("fault_applied", goal=f["goal"])
         if "cpu_hog" in f:
-            threading.Thread(target=hog, args=(float(f["cpu_hog"]),), daemon=True).start()
+            seconds = float(f["cpu_hog"])
+            log.log("cpu_hog_start", seconds=seconds, threads=int(f.get("threads", 1)))
+            for _ in range(int(f.get("threads", 1))):
+                threading.Thread(target=hog, args=(seconds, time.monotonic() + seconds), daemon=True).start()
 
     on_fault(fault)
     rospy.Subscriber("/odom", Odometry, odom, tcp_nodelay=True)
@@ -57,8 +58,7 @@ def main() -> None:
         left = rospy.Publisher("/wheel_left/cmd", Float64, queue_size=10, tcp_nodelay=True)
         right = rospy.Publisher("/wheel_right/cmd", Float64, queue_size=10, tcp_nodelay=True)
         wheels = DiffDrive(track=0.3)
-    rate = rospy.Rate(20)
-    while not rospy.is_shutdown():
+    def step() -> None:
         v, w = go_to_goal(pose["x"], pose["y"], pose["yaw"], goal[0], goal[1], v_max, w_max) if pose["seen"] \
             else (0.0, 0.0)
         if robot == "kobuki":
@@ -69,10 +69,8 @@ def main() -> None:
             lw, rw = wheels.wheels_for(v, w)
             left.publish(Float64(lw))
             right.publish(Float64(rw))
-        try:
-            rate.sleep()
-        except rospy.ROSInterruptException:
-            break
+
+    loop(20.0, step)
 
 
 if __name__ == "__main__":

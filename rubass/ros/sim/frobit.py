@@ -28,7 +28,7 @@ from std_msgs.msg import Float64, Header
 
 from ...sim.faults import WheelFault
 from ...sim.kinematics import DiffDrive
-from .common import odometry, on_fault
+from .common import loop, odometry, on_fault
 from .eventlog import EventLog
 
 MUX_TIMEOUT = 0.5
@@ -106,9 +106,9 @@ def main() -> None:
     rospy.Subscriber(rospy.get_param("~heartbeat_topic", "/rubass/heartbeat"), Header, board.beat, tcp_nodelay=True)
     enc = {s: rospy.Publisher(f"/wheel_{s}/encoder", Float64, queue_size=10, tcp_nodelay=True) for s in SIDES}
     odom = rospy.Publisher("/odom", type(odometry(base, rospy.Time())), queue_size=10, tcp_nodelay=True)
-    dt, tick = 0.01, 0
-    rate = rospy.Rate(1.0 / dt)
-    while not rospy.is_shutdown():
+    dt, ticks = 0.01, [0]
+
+    def step() -> None:
         now = time.monotonic()
         board.check_watchdog()
         targets = []
@@ -118,15 +118,13 @@ def main() -> None:
                 value = 0.0
             targets.append(0.0 if board.cut else faults[side].motor_target(value))
         base.step(targets[0], targets[1], dt)
-        tick += 1
-        if tick % 5 == 0:  # encoders and odometry at 20 Hz
+        ticks[0] += 1
+        if ticks[0] % 5 == 0:  # encoders and odometry at 20 Hz
             for side, actual in zip(SIDES, (base.left, base.right)):
                 enc[side].publish(Float64(faults[side].encoder_reading(actual, rng)))
             odom.publish(odometry(base, rospy.Time.now()))
-        try:
-            rate.sleep()
-        except rospy.ROSInterruptException:
-            break
+
+    loop(1.0 / dt, step)
 
 
 if __name__ == "__main__":

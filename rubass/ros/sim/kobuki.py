@@ -18,7 +18,7 @@ from geometry_msgs.msg import Twist
 from sensor_msgs.msg import JointState
 
 from ...sim.kinematics import DiffDrive
-from .common import odometry
+from .common import loop, odometry
 from .eventlog import EventLog
 
 MUX_TIMEOUT = 0.5
@@ -43,8 +43,8 @@ def main() -> None:
     odom = rospy.Publisher("/odom", type(odometry(base, rospy.Time())), queue_size=10, tcp_nodelay=True)
     joints = rospy.Publisher("/mobile_base/sensors/joint_states", JointState, queue_size=10, tcp_nodelay=True)
     dt = 0.02
-    rate = rospy.Rate(1.0 / dt)
-    while not rospy.is_shutdown():
+
+    def step() -> None:
         now = time.monotonic()
         twist = Twist()
         for source in ("safety", "normal"):
@@ -60,10 +60,8 @@ def main() -> None:
         js = JointState(name=["wheel_left", "wheel_right"], velocity=[base.left, base.right])
         js.header.stamp = stamp
         joints.publish(js)
-        try:
-            rate.sleep()
-        except rospy.ROSInterruptException:
-            break
+
+    loop(1.0 / dt, step)
 
 
 if __name__ == "__main__":

@@ -14,11 +14,9 @@ import json
 import os
 import shutil
 import signal
-import socket
 import subprocess
 import sys
 import time
-import uuid
 from dataclasses import asdict, dataclass, field
 from typing import Any, Dict, List, Optional
 
@@ -26,10 +24,10 @@ from ...lang import load_spec
 from ...replay.run import replay
 from ...sim.rows import Row
 from ..bag import BagError, open_bag, read
+from ..master import ROOT, PrivateMaster, stop_processes, wait_for_service
 from .eventlog import read_events
 
 PY = "/usr/bin/python3"
-ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))))
 CONFIG = os.path.join(ROOT, "config")
 WARMUP = 1.5        # seconds of normal driving before the fault
 STOP_TIMEOUT = 25.0  # seconds after the fault to wait for the stop
@@ -53,25 +51,9 @@ class Session:
 
     def __init__(self, out: str) -> None:
         self.out = out
-        with socket.socket() as s:
-            s.bind(("127.0.0.1", 0))
-            self.port = s.getsockname()[1]
-        self.env = dict(os.environ, ROS_MASTER_URI=f"http://127.0.0.1:{self.port}", ROS_IP="127.0.0.1",
-                        ROS_HOME=os.path.join(out, "ros_home"), PYTHONPATH=ROOT + os.pathsep + os.environ.get("PYTHONPATH", ""),
-                        PYTHONDONTWRITEBYTECODE="1")
-        self.env.pop("ROS_HOSTNAME", None)
-        os.makedirs(self.env["ROS_HOME"], exist_ok=True)
-        self.master = subprocess.Popen(["rosmaster", "--core", "-p", str(self.port)], env=self.env,
-                                       stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True)
-        os.environ.update({k: self.env[k] for k in ("ROS_MASTER_URI", "ROS_IP", "ROS_HOME")})
-        import rosgraph
-
-        end = time.time() + 10
-        while not rosgraph.is_master_online(self.env["ROS_MASTER_URI"]):
-            if time.time() > end:
-                raise RuntimeError("rosmaster did not start")
-            time.sleep(0.05)
-        rosgraph.Master("/rubass_experiments").setParam("/run_id", str(uuid.uuid1()))
+        self.master = PrivateMaster(os.path.join(out, "ros_home"))
+        self.env = self.master.env
+        self.master.join()
         import rospy
         from std_msgs.msg import String
 
@@ -82,22 +64,7 @@ class Session:
         import rospy
 
         rospy.signal_shutdown("experiments done")
-        _stop([self.master])
-
-
-def _stop(procs: List[subprocess.Popen], sig: int = signal.SIGTERM) -> None:
-    for p in procs:
-        if p.poll() is None:
-            try:
-                os.killpg(p.pid, sig)
-            except ProcessLookupError:
-                pass
-    for p in procs:
-        try:
-            p.wait(5)
-        except subprocess.TimeoutExpired:
-            os.killpg(p.pid, signal.SIGKILL)
-            p.wait(5)
+        self.master.stop()
 
 
 def _spec_for(row: Row, run_dir: str) -> str:
@@ -154,7 +121,7 @@ def run_once(session: Session, row: Row, rep: int) -> RunResult:
             _wait(lambda: os.path.lexists(os.path.join(run_dir, "board")), 15, "the safety board's port")
         monitor = spawn("monitor", [PY, os.path.join(ROOT, "scripts", "monitor"), "__name:=rubass",
                                     f"_spec:={spec_path}", "_node_rate:=10"])
-        _wait_service("/rubass/reset", monitor, 30)
+        wait_for_service("/rubass/reset", monitor, session.master.uri, 30)
         expected = 3 if row.robot == "kobuki" else 2  # the nodes that listen to /sim/fault
         _wait(lambda: session.faults.get_num_connections() >= expected, 15, "the simulated nodes")
         time.sleep(WARMUP)
@@ -167,7 +134,7 @@ def run_once(session: Session, row: Row, rep: int) -> RunResult:
         while time.time() < end and not any(e["event"] == "stop_received" for e in read_events(events_file)):
             time.sleep(0.01)
         time.sleep(0.3)  # let the recorder catch the last messages
-        _stop([recorder], signal.SIGINT)
+        stop_processes([recorder], signal.SIGINT)
         # rosbag's recorder (a child process) renames run.bag.active to run.bag after its parent exits
         _wait(lambda: os.path.exists(bag) and not os.path.exists(bag + ".active"), 15, "the bag")
         result.events = read_events(events_file)
@@ -175,8 +142,8 @@ def run_once(session: Session, row: Row, rep: int) -> RunResult:
     except Exception as exc:  # a run that breaks is reported, and the others go on
         result.error = f"{exc.__class__.__name__}: {exc}"
     finally:
-        _stop([p for p in procs if p is not recorder])
-        _stop([recorder], signal.SIGINT)
+        stop_processes([p for p in procs if p is not recorder])
+        stop_processes([recorder], signal.SIGINT)
     return result
 
 
@@ -186,23 +153,6 @@ def _wait(cond: Any, timeout: float, what: str) -> None:
         if time.time() > end:
             raise RuntimeError(f"{what} did not come up within {timeout:g} s")
         time.sleep(0.02)
-
-
-def _wait_service(name: str, proc: subprocess.Popen, timeout: float) -> None:
-    import rosgraph
-
-    master = rosgraph.Master("/rubass_experiments")
-
-    def up() -> bool:
-        if proc.poll() is not None:
-            raise RuntimeError(f"the monitor exited with {proc.returncode}")
-        try:
-            master.lookupService(name)
-            return True
-        except rosgraph.MasterError:
-            return False
-
-    _wait(up, timeout, "the monitor")
 
 
 def _first(events: List[Dict[str, Any]], name: str, after: float = 0.0) -> Optional[float]:

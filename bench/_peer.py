@@ -1,0 +1,114 @@
+#!/usr/bin/python3
+"""ROS processes for the benchmarks: `_peer.py ROLE [args]`, each its own node.
+
+echo            republish /bench/raw on /bench/raw_back at once (the raw rospy hop, twice)
+load N HZ       publish N topics /bench/load_I (std_msgs/Float64) at HZ each
+driver MODE HZ SECONDS   measure, printing one JSON line:
+    raw:    publish a stamped Header on /bench/raw at HZ; round trip via echo -> one hop = rtt/2
+    rubass: alternate /bench/cmd (geometry_msgs/PointStamped) between violating (x=2) and clear
+            (x=0) at HZ; each violation's time to the stop on /bench/stop (std_msgs/Header)
+"""
+import json
+import sys
+import threading
+import time
+
+import rospy
+from geometry_msgs.msg import PointStamped
+from std_msgs.msg import Float64, Header
+
+
+def echo():
+    rospy.init_node("bench_echo")
+    pub = rospy.Publisher("/bench/raw_back", Header, queue_size=100, tcp_nodelay=True)
+    rospy.Subscriber("/bench/raw", Header, pub.publish, tcp_nodelay=True)
+    rospy.spin()
+
+
+def load(n, hz):
+    rospy.init_node("bench_load")
+    pubs = [rospy.Publisher(f"/bench/load_{i}", Float64, queue_size=10, tcp_nodelay=True) for i in range(n)]
+    rate = rospy.Rate(hz)
+    k = 0
+    while not rospy.is_shutdown():
+        k += 1
+        for p in pubs:
+            p.publish(Float64(k % 7))
+        try:
+            rate.sleep()
+        except rospy.ROSInterruptException:
+            break
+
+
+def driver(mode, hz, seconds):
+    rospy.init_node("bench_driver")
+    lat = []
+    lock = threading.Lock()
+    sent = {}
+    state = {"last_violation": None, "answered": True}
+    if mode == "raw":
+        pub = rospy.Publisher("/bench/raw", Header, queue_size=100, tcp_nodelay=True)
+
+        def back(msg):
+            now = time.time()
+            with lock:
+                t = sent.pop(msg.seq, None)
+            if t is not None:
+                lat.append((now - t) / 2.0)
+
+        rospy.Subscriber("/bench/raw_back", Header, back, tcp_nodelay=True)
+        wait_for = "/bench/raw_back"
+    else:
+        pub = rospy.Publisher("/bench/cmd", PointStamped, queue_size=100, tcp_nodelay=True)
+
+        def stop(msg):
+            now = time.time()
+            with lock:
+                if state["last_violation"] is not None and not state["answered"]:
+                    lat.append(now - state["last_violation"])
+                    state["answered"] = True
+
+        rospy.Subscriber("/bench/stop", Header, stop, tcp_nodelay=True)
+        wait_for = "/bench/stop"
+    end = time.time() + 15
+    while pub.get_num_connections() < 1 and time.time() < end:
+        time.sleep(0.01)
+    while wait_for not in dict(rospy.get_published_topics()) and time.time() < end:
+        time.sleep(0.05)
+    time.sleep(0.5)
+    period = 1.0 / hz
+    n = int(seconds * hz)
+    missed = 0
+    t_next = time.time()
+    for i in range(n):
+        t_next += period
+        if mode == "raw":
+            with lock:
+                sent[i] = time.time()
+            pub.publish(Header(seq=i))
+        else:
+            msg = PointStamped()
+            violate = i % 2 == 0
+            msg.point.x = 2.0 if violate else 0.0
+            with lock:
+                if violate:
+                    if not state["answered"]:
+                        missed += 1
+                    state["last_violation"], state["answered"] = time.time(), False
+                pub.publish(msg)
+        delay = t_next - time.time()
+        if delay > 0:
+            time.sleep(delay)
+    time.sleep(0.3)
+    expected = n if mode == "raw" else (n + 1) // 2
+    print(json.dumps({"latencies": lat, "expected": expected, "unanswered": expected - len(lat)}))
+
+
+if __name__ == "__main__":
+    role = sys.argv[1]
+    if role == "echo":
+        echo()
+    elif role == "load":
+        load(int(sys.argv[2]), float(sys.argv[3]))
+    else:
+        driver(sys.argv[2], float(sys.argv[3]), float(sys.argv[4]))

@@ -1,0 +1,100 @@
+#!/usr/bin/python3
+"""Reaction time against the physical limit, measured side by side in one run.
+
+(a) the raw rospy hop: publisher -> subscriber (half the round trip through an echo node);
+(b) rubass: violating message published -> the monitor's stop received by a subscriber
+    standing in for the base (two hops plus evaluation and dispatch).
+At 100 Hz and 1 kHz, alone and with background load (20 other topics at 100 Hz and 100
+other rules in the monitor). Prints one JSON object per case, with p50/p99/max of (a) and
+(b) and the ratio (b) / 2·(a) at the median. Targets: (b) p50 <= 2x the two raw hops and
+(b) p99 <= 3 ms under the background load.
+Usage: bench/reaction.py [--seconds S] [--smoke]
+"""
+import argparse
+import json
+import os
+import subprocess
+import sys
+import tempfile
+
+import _common
+from rubass.ros.master import PrivateMaster, stop_processes, wait_for_service  # noqa: E402
+
+PEER = os.path.join(os.path.dirname(os.path.abspath(__file__)), "_peer.py")
+PY = "/usr/bin/python3"
+LOAD_TOPICS = 20
+
+
+def spec_text(loaded):
+    rules = ["  hit: topic /bench/cmd.point.x > 1;"]
+    if loaded:
+        for i in range(LOAD_TOPICS):
+            for k in range(5):
+                rules.append(f"  l{i}_{k}: (topic /bench/load_{i}.data > {10 + k}) for 1 s;")
+    return ("import \"lib.yaml\";\naction primitive stop;\nentity bench { rules:\n" + "\n".join(rules) +
+            "\n}\nif (bench.hit) then { stop; }\n")
+
+
+LIB = "actions:\n  stop: {plugin: publish, topic: /bench/stop, type: std_msgs/Header, message: {}, rate: 1 Hz}\n"
+
+
+def measure(master, tmp, mode, hz, seconds, loaded):
+    procs = []
+    try:
+        if loaded:
+            procs.append(master.spawn([PY, PEER, "load", str(LOAD_TOPICS), "100"]))
+        if mode == "raw":
+            procs.append(master.spawn([PY, PEER, "echo"]))
+        else:
+            with open(os.path.join(tmp, "lib.yaml"), "w") as fh:
+                fh.write(LIB)
+            spec = os.path.join(tmp, "bench.rbs")
+            with open(spec, "w") as fh:
+                fh.write(spec_text(loaded))
+            mon = master.spawn([PY, os.path.join(_common.ROOT, "scripts", "monitor"), "__name:=rubass", f"_spec:={spec}"],
+                               log=os.path.join(tmp, "monitor.log"))
+            procs.append(mon)
+            wait_for_service("/rubass/reset", mon, master.uri, 30)
+        out = subprocess.run([PY, PEER, "driver", mode, str(hz), str(seconds)], env=master.env, capture_output=True,
+                             text=True, timeout=seconds + 60)
+        if out.returncode != 0:
+            raise SystemExit(out.stderr)
+        return json.loads(out.stdout.strip().splitlines()[-1])
+    finally:
+        stop_processes(procs)
+
+
+def summary(lat):
+    p = _common.percentile
+    return {"n": len(lat), "p50_ms": round(p(lat, 50) * 1e3, 3), "p99_ms": round(p(lat, 99) * 1e3, 3),
+            "max_ms": round(max(lat) * 1e3, 3) if lat else None}
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--seconds", type=float, default=5.0, help="per case (default 5)")
+    ap.add_argument("--smoke", action="store_true", help="one short case, to check it works")
+    args = ap.parse_args()
+    cases = [(100, False)] if args.smoke else [(100, False), (1000, False), (100, True), (1000, True)]
+    seconds = 0.5 if args.smoke else args.seconds
+    with tempfile.TemporaryDirectory() as tmp:
+        master = PrivateMaster(os.path.join(tmp, "home"))
+        try:
+            for hz, loaded in cases:
+                raw = measure(master, tmp, "raw", hz, seconds, loaded)
+                rb = measure(master, tmp, "rubass", hz, seconds, loaded)
+                a, b = summary(raw["latencies"]), summary(rb["latencies"])
+                ratio = b["p50_ms"] / (2 * a["p50_ms"]) if a["p50_ms"] else None
+                print(json.dumps({
+                    "benchmark": "reaction", "rate_hz": hz, "background_load": loaded, "seconds": seconds,
+                    "raw_hop": a, "rubass": b, "rubass_unanswered": rb["unanswered"],
+                    "ratio_p50_b_over_2a": None if ratio is None else round(ratio, 2),
+                    "targets": {"p50_le_2x_two_hops": ratio is not None and ratio <= 2.0,
+                                "p99_le_3ms": b["p99_ms"] <= 3.0},
+                    **_common.machine()}), flush=True)
+        finally:
+            master.stop()
+
+
+if __name__ == "__main__":
+    sys.exit(main())
