@@ -2,7 +2,8 @@
 """ROS processes for the benchmarks: `_peer.py ROLE [args]`, each its own node.
 
 echo            republish /bench/raw on /bench/raw_back at once (the raw rospy hop, twice)
-load N HZ       publish N topics /bench/load_I (std_msgs/Float64) at HZ each
+load N HZ [FIRST]  publish N topics /bench/load_I (I from FIRST; std_msgs/Float64) at HZ each
+timed T COUNT   one violation then silence, COUNT times, against a rule `for T s`
 driver MODE HZ SECONDS   measure, printing one JSON line:
     raw:    publish a stamped Header on /bench/raw at HZ; round trip via echo -> one hop = rtt/2
     rubass: alternate /bench/cmd (geometry_msgs/PointStamped) between violating (x=2) and clear
@@ -25,9 +26,9 @@ def echo():
     rospy.spin()
 
 
-def load(n, hz):
-    rospy.init_node("bench_load")
-    pubs = [rospy.Publisher(f"/bench/load_{i}", Float64, queue_size=10, tcp_nodelay=True) for i in range(n)]
+def load(n, hz, first=0):
+    rospy.init_node("bench_load", anonymous=True)
+    pubs = [rospy.Publisher(f"/bench/load_{i}", Float64, queue_size=10, tcp_nodelay=True) for i in range(first, first + n)]
     rate = rospy.Rate(hz)
     k = 0
     while not rospy.is_shutdown():
@@ -104,11 +105,57 @@ def driver(mode, hz, seconds):
     print(json.dumps({"latencies": lat, "expected": expected, "unanswered": expected - len(lat)}))
 
 
+def timed(duration, count):
+    """One violation, then silence: the stop's arrival minus (t0 + T); and the monitor's own
+    error from its ~events (dispatch minus the deadline)."""
+    from std_msgs.msg import String
+
+    rospy.init_node("bench_timed")
+    pub = rospy.Publisher("/bench/cmd", PointStamped, queue_size=10, tcp_nodelay=True)
+    got = threading.Event()
+    arrival = {}
+    own = []
+
+    def stop(msg):
+        if not got.is_set():
+            arrival["t"] = time.time()
+            got.set()
+
+    def event(msg):
+        e = json.loads(msg.data)
+        if e["event"] == "start" and e["cause"] == "deadline" and e["latency_ms"] is not None:
+            own.append(e["latency_ms"] / 1000.0)
+
+    rospy.Subscriber("/bench/stop", Header, stop, tcp_nodelay=True)
+    rospy.Subscriber("/rubass/events", String, event, tcp_nodelay=True)
+    end = time.time() + 15
+    while (pub.get_num_connections() < 1 or "/bench/stop" not in dict(rospy.get_published_topics())) \
+            and time.time() < end:
+        time.sleep(0.05)
+    time.sleep(0.5)
+    errors = []
+    for _ in range(count):
+        got.clear()
+        msg = PointStamped()
+        msg.point.x = 2.0
+        t0 = time.time()
+        pub.publish(msg)
+        if got.wait(duration + 2.0):
+            errors.append(arrival["t"] - t0 - duration)
+        msg.point.x = 0.0
+        pub.publish(msg)
+        time.sleep(0.15)
+    time.sleep(0.2)
+    print(json.dumps({"errors": errors, "monitor_errors": own, "expected": count}))
+
+
 if __name__ == "__main__":
     role = sys.argv[1]
     if role == "echo":
         echo()
     elif role == "load":
-        load(int(sys.argv[2]), float(sys.argv[3]))
+        load(int(sys.argv[2]), float(sys.argv[3]), int(sys.argv[4]) if len(sys.argv) > 4 else 0)
+    elif role == "timed":
+        timed(float(sys.argv[2]), int(sys.argv[3]))
     else:
         driver(sys.argv[2], float(sys.argv[3]), float(sys.argv[4]))

@@ -13,53 +13,23 @@ Usage: bench/reaction.py [--seconds S] [--smoke]
 import argparse
 import json
 import os
-import subprocess
 import sys
 import tempfile
 
 import _common
-from rubass.ros.master import PrivateMaster, stop_processes, wait_for_service  # noqa: E402
+from _rosbench import PY, PEER, PrivateMaster, run_peer, spec_text, start_load, start_monitor, stop_processes
 
-PEER = os.path.join(os.path.dirname(os.path.abspath(__file__)), "_peer.py")
-PY = "/usr/bin/python3"
-LOAD_TOPICS = 20
-
-
-def spec_text(loaded):
-    rules = ["  hit: topic /bench/cmd.point.x > 1;"]
-    if loaded:
-        for i in range(LOAD_TOPICS):
-            for k in range(5):
-                rules.append(f"  l{i}_{k}: (topic /bench/load_{i}.data > {10 + k}) for 1 s;")
-    return ("import \"lib.yaml\";\naction primitive stop;\nentity bench { rules:\n" + "\n".join(rules) +
-            "\n}\nif (bench.hit) then { stop; }\n")
-
-
-LIB = "actions:\n  stop: {plugin: publish, topic: /bench/stop, type: std_msgs/Header, message: {}, rate: 1 Hz}\n"
+LOAD_TOPICS, LOAD_RULES = 20, 100
 
 
 def measure(master, tmp, mode, hz, seconds, loaded):
-    procs = []
+    procs = start_load(master, LOAD_TOPICS, 100) if loaded else []
     try:
-        if loaded:
-            procs.append(master.spawn([PY, PEER, "load", str(LOAD_TOPICS), "100"]))
         if mode == "raw":
             procs.append(master.spawn([PY, PEER, "echo"]))
         else:
-            with open(os.path.join(tmp, "lib.yaml"), "w") as fh:
-                fh.write(LIB)
-            spec = os.path.join(tmp, "bench.rbs")
-            with open(spec, "w") as fh:
-                fh.write(spec_text(loaded))
-            mon = master.spawn([PY, os.path.join(_common.ROOT, "scripts", "monitor"), "__name:=rubass", f"_spec:={spec}"],
-                               log=os.path.join(tmp, "monitor.log"))
-            procs.append(mon)
-            wait_for_service("/rubass/reset", mon, master.uri, 30)
-        out = subprocess.run([PY, PEER, "driver", mode, str(hz), str(seconds)], env=master.env, capture_output=True,
-                             text=True, timeout=seconds + 60)
-        if out.returncode != 0:
-            raise SystemExit(out.stderr)
-        return json.loads(out.stdout.strip().splitlines()[-1])
+            procs.append(start_monitor(master, tmp, spec_text(LOAD_TOPICS, LOAD_RULES if loaded else 0))[0])
+        return run_peer(master, ["driver", mode, str(hz), str(seconds)], seconds + 60)
     finally:
         stop_processes(procs)
 

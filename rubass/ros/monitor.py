@@ -38,7 +38,7 @@ from ..engine.loop import EngineLoop, Message, NodeSample
 from ..lang import SpecError, load_spec
 from ..lang.model import CheckedSpec
 from . import status as status_mod
-from .actions.base import ActionSetupError, make_plugin
+from .actions.base import ActionSetupError, Context, make_plugin
 from .actions.runner import ActionRunner
 from .dispatch import Dispatcher
 from .nodes import NodeSampler
@@ -207,7 +207,6 @@ class Monitor:
             if b.latched:
                 self.dispatcher.orphans.append((b, old_keys[b.index]))
             else:
-                from .actions.base import Context
                 self.dispatcher.send("release", b, Context(b.index, b.span.line, (), (), now, old_keys[b.index]))
         self.dispatcher.runners = runners
         self.loop.engine = new
@@ -261,7 +260,6 @@ class Monitor:
 
         def release(engine: Engine) -> None:
             keys = Dispatcher.keys(engine.spec.behaviours)
-            from .actions.base import Context
             for index in engine.active_behaviours():
                 b = engine.spec.behaviours[index - 1]
                 if not b.latched:
@@ -275,6 +273,9 @@ class Monitor:
         self._stopping = True
         self.loop.stop()
         self.sampler.stop()
+        received = sum(st.messages for st in self.watcher.status())
+        rospy.loginfo("rubass: stopped after %d messages (%d dropped: the engine's queue was full), %d reloads",
+                      received, self.loop.dropped, self.reloads)
         self.watcher.close()
         for runner in self.runners.values():
             runner.stop(timeout=1.0)

@@ -36,3 +36,16 @@ def test_replay_throughput(tmp_path):
     pytest.importorskip("rosbag")
     (figures,) = bench("replay_throughput.py", "--messages", "4000", "--dir", str(tmp_path))
     assert figures["messages"] == 4000 and figures["messages_per_s"] > 0
+
+
+@pytest.mark.ros
+@pytest.mark.parametrize("script", ["reaction.py", "timed.py", "scale.py", "reload.py"])
+def test_ros_benchmarks(script):
+    if not os.path.exists("/usr/bin/rosmaster"):
+        pytest.skip("ROS 1 is not installed")
+    rows = bench(script, "--smoke")
+    assert rows and all(r["benchmark"] == script[:-3] for r in rows)
+    if script == "reaction.py":
+        assert rows[0]["raw_hop"]["n"] > 0 and rows[0]["rubass"]["n"] > 0
+    if script == "reload.py":
+        assert rows[0]["reloads"] == 2 and rows[0]["missed"] == 0

@@ -1,0 +1,55 @@
+#!/usr/bin/python3
+"""`for` fire instants through the live monitor: one violating message then silence, and the
+stop's arrival at a subscriber minus (t0 + T), for T from 0 to 2 s. Also the monitor's own
+error (its ~events: dispatch minus the deadline), without the two ROS hops.
+Target: p99 <= 1 ms. Usage: bench/timed.py [--count N] [--smoke]
+"""
+import argparse
+import json
+import os
+import sys
+import tempfile
+
+import _common
+from _rosbench import PrivateMaster, run_peer, spec_text, start_monitor, stop_processes
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--count", type=int, default=30, help="firings per T of 0.5 s or less (fewer for longer T)")
+    ap.add_argument("--smoke", action="store_true")
+    args = ap.parse_args()
+    durations = [0.1] if args.smoke else [0.0, 0.05, 0.1, 0.5, 1.0, 2.0]
+    all_errors, all_own = [], []
+    with tempfile.TemporaryDirectory() as tmp:
+        master = PrivateMaster(os.path.join(tmp, "home"))
+        try:
+            for T in durations:
+                count = 2 if args.smoke else (args.count if T <= 0.5 else max(5, args.count // 3))
+                mon, _ = start_monitor(master, tmp, spec_text(1, 0, f"(topic /bench/cmd.point.x > 1) for {T} s"))
+                try:
+                    r = run_peer(master, ["timed", str(T), str(count)], count * (T + 3) + 60)
+                finally:
+                    stop_processes([mon])
+                errs, own = r["errors"], r["monitor_errors"]
+                all_errors += errs
+                all_own += own
+                p = _common.percentile
+                print(json.dumps({
+                    "benchmark": "timed", "T_s": T, "firings": len(errs), "missed": r["expected"] - len(errs),
+                    "at_subscriber_ms": {"p50": round(p(errs, 50) * 1e3, 3), "p99": round(p(errs, 99) * 1e3, 3),
+                                         "max": round(max(errs) * 1e3, 3) if errs else None},
+                    "monitor_own_ms": {"p50": round(p(own, 50) * 1e3, 3), "p99": round(p(own, 99) * 1e3, 3)}
+                    if own else None,
+                    **_common.machine()}), flush=True)
+        finally:
+            master.stop()
+    p = _common.percentile
+    print(json.dumps({"benchmark": "timed", "T_s": "all", "firings": len(all_errors),
+                      "at_subscriber_p99_ms": round(p(all_errors, 99) * 1e3, 3),
+                      "monitor_own_p99_ms": round(p(all_own, 99) * 1e3, 3) if all_own else None,
+                      "target_p99_ms": 1.0, "met": p(all_errors, 99) <= 0.001}))
+
+
+if __name__ == "__main__":
+    sys.exit(main())
