@@ -55,6 +55,10 @@ def main():
         "reload_ms_median": sorted(times)[len(times) // 2] if times else None,
         "reload_ms_max": max(times) if times else None,
         "violations": result.get("expected"), "missed": result.get("unanswered"),
+        "reaction_during_reloads_ms": {
+            "p50": round(_common.percentile(result.get("latencies", []), 50) * 1e3, 3),
+            "p99": round(_common.percentile(result.get("latencies", []), 99) * 1e3, 3),
+            "max": round(max(result.get("latencies", [0])) * 1e3, 3)},
         "targets": {"under_1s": bool(times) and max(times) < 1000, "none_missed": result.get("unanswered") == 0},
         **_common.machine()}))
 

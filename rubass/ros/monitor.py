@@ -169,6 +169,7 @@ class Monitor:
             t0 = time.monotonic()
             try:
                 spec = load_spec(self.config.spec, self.config.actions)
+                t_check = time.monotonic()
                 runners = self._runners(spec, self.runners)
             except (SpecError, StartupError) as exc:
                 text = exc.render() if isinstance(exc, SpecError) else str(exc)
@@ -177,10 +178,12 @@ class Monitor:
                 rospy.logerr("rubass: reload (%s) rejected, the previous rules keep running:\n%s", reason, text)
                 return False, f"rejected: {text}"
             new_engine = Engine(spec, _ros_now())
+            t_build = time.monotonic()
             for name, runner in runners.items():
                 if self.runners.get(name) is not runner:
                     runner.start_thread()
             self.loop.call(lambda old: self._swap(old, new_engine, spec, runners))
+            t_swap = time.monotonic()
             self.watcher.sync(spec)
             if spec.nodes != self.spec.nodes:
                 self.sampler.stop()
@@ -193,8 +196,9 @@ class Monitor:
             self.reloads += 1
             self.last_reload_error = ""
             ms = (time.monotonic() - t0) * 1000.0
-            rospy.loginfo("rubass: reloaded %s (%s) in %.0f ms: %d rules, %d behaviours", spec.path, reason, ms,
-                          len(spec.rules), len(spec.behaviours))
+            rospy.loginfo("rubass: reloaded %s (%s) in %.0f ms: %d rules, %d behaviours (check %.0f ms, build %.0f ms, "
+                          "swap %.1f ms)", spec.path, reason, ms, len(spec.rules), len(spec.behaviours),
+                          (t_check - t0) * 1000, (t_build - t_check) * 1000, (t_swap - t_build) * 1000)
             return True, f"reloaded in {ms:.0f} ms: {len(spec.rules)} rules, {len(spec.behaviours)} behaviours"
 
     def _swap(self, old: Engine, new: Engine, spec: CheckedSpec, runners: Dict[str, ActionRunner]) -> None:
