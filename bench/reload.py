@@ -50,10 +50,15 @@ def main():
             master.stop()
         log = open(os.path.join(tmp, "monitor.log")).read()
     times = [float(x) for x in re.findall(r"rubass: reloaded .* in (\d+) ms", log)]
+    phases = re.findall(r"\(check (\d+) ms, build (\d+) ms, swap ([\d.]+) ms\)", log)
+    swaps = [float(p[2]) for p in phases]
+    checks = [float(p[0]) for p in phases]
     print(json.dumps({
         "benchmark": "reload", "rules": rules + 1, "reloads": len(times), "asked": reloads,
         "reload_ms_median": sorted(times)[len(times) // 2] if times else None,
         "reload_ms_max": max(times) if times else None,
+        "check_ms_median": sorted(checks)[len(checks) // 2] if checks else None,
+        "swap_ms_max": max(swaps) if swaps else None,
         "violations": result.get("expected"), "missed": result.get("unanswered"),
         "reaction_during_reloads_ms": {
             "p50": round(_common.percentile(result.get("latencies", []), 50) * 1e3, 3),
