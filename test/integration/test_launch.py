@@ -34,3 +34,23 @@ def test_monitor_launch_included_from_another_launch_file(ros, tmp_path):
     assert any(r["kind"] == "recv" for r in rec), ros.log(launch)
     launch.send_signal(signal.SIGINT)
     assert launch.wait(20) == 0
+
+
+def test_kobuki_sim_launch_stops_the_simulated_base_on_a_drift_fault(ros, tmp_path):
+    ros.env["ROS_PACKAGE_PATH"] = ROOT + os.pathsep + ros.env.get("ROS_PACKAGE_PATH", "/usr/share")
+    launch = ros.spawn(["roslaunch", "--wait", "rubass", "kobuki_sim.launch"], "roslaunch")
+    ros.wait_service("/rubass/reset", launch, timeout=30)
+    rec = ros.probe({"listen": [{"topic": "/mobile_base/commands/safety_velocity", "type": "geometry_msgs/Twist"},
+                                {"topic": "/odom", "type": "nav_msgs/Odometry"}],
+                     "advertise": [{"topic": "/sim/fault", "type": "std_msgs/String"}],
+                     "steps": [{"wait_subscribers": "/sim/fault", "count": 3}, {"wait": "/odom", "timeout": 10},
+                               {"sleep": 1.0}, {"mark": "fault"},
+                               {"publish": "/sim/fault", "msg": {"data": '{"drift": "linear", "rate": 0.5}'}},
+                               {"wait": "/mobile_base/commands/safety_velocity", "timeout": 10}]})
+    fault = next(r["wall"] for r in rec if r["kind"] == "mark")
+    stops = [r for r in rec if r["kind"] == "recv" and r["topic"] == "/mobile_base/commands/safety_velocity"]
+    assert stops, ros.log(launch)
+    # the drift passes 0.5 m/s about 0.4 s after the fault, and the rule wants 1 s of it
+    assert 1.0 < stops[0]["wall"] - fault < 3.0
+    launch.send_signal(signal.SIGINT)
+    assert launch.wait(20) == 0
