@@ -17,7 +17,7 @@ def print_table(data: Dict[str, Any], out: TextIO) -> bool:
               "the limit, the crossing of the border, or the start of the CPU loop, to the stop reaching the base).\n"
               "(b): the monitor's own delay, from the instant its rule became due to the stop reaching the base (ms).\n\n")
     head = (f"{'row':<13} {'ideal':>5} | {'paper: avg':>10} {'sd':>5} {'min':>5} {'max':>5} | {'ours (a): avg':>13} {'sd':>5} "
-            f"{'min':>5} {'max':>5} | {'(b) ms: avg':>11} {'p99':>6} {'max':>6} | stopped")
+            f"{'min':>5} {'max':>5} | {'(b) ms: avg':>11} {'sd':>5} {'min':>5} {'max':>5} {'p99':>5} | stopped")
     out.write(head + "\n" + "-" * len(head) + "\n")
     for r in data["rows"]:
         a, b, p = r["a"] or {}, r["b"] or {}, r["paper"]
@@ -26,7 +26,8 @@ def print_table(data: Dict[str, Any], out: TextIO) -> bool:
         ok = ok and r["stopped"] == r["runs"] and r["runs"] > 0 and b_ok
         out.write(f"{r['row']:<13} {r['ideal']:>5.2f} | {p['avg']:>10.2f} {p['sd']:>5.2f} {p['min']:>5.2f} {p['max']:>5.2f} | "
                   f"{_fmt(a.get('avg')):>13} {_fmt(a.get('sd')):>5} {_fmt(a.get('min')):>5} {_fmt(a.get('max')):>5} | "
-                  f"{_fmt(b.get('avg'), 1000, 1):>11} {_fmt(b.get('p99'), 1000, 1):>6} {_fmt(b.get('max'), 1000, 1):>6} | "
+                  f"{_fmt(b.get('avg'), 1000, 1):>11} {_fmt(b.get('sd'), 1000, 1):>5} {_fmt(b.get('min'), 1000, 1):>5} "
+                  f"{_fmt(b.get('max'), 1000, 1):>5} {_fmt(b.get('p99'), 1000, 1):>5} | "
                   f"{stopped}{'' if r['stopped'] == r['runs'] else '  NOT EVERY TIME'}\n")
     notes = [f"{r['row']}: {r['note']}" for r in data["rows"] if r["note"]]
     errors = [f"{r['row']}: {e}" for r in data["rows"] for e in r["errors"]]
