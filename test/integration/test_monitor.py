@@ -341,3 +341,20 @@ def test_service_action_calls_the_service_and_a_hung_one_times_out_without_block
     brake = next(r["wall"] for r in rec if r["kind"] == "recv")
     assert brake - sent < 0.1, "the hung service did not delay the other actions"
     assert "action 'hung_srv' start failed" in ros.log(mon) and "did not answer within 0.3 s" in ros.log(mon)
+
+
+def test_a_node_hung_with_sigstop_is_not_alive_within_a_sample_and_its_timeout(ros, tmp_path):
+    victim = ros.probe_bg({"node": "victim", "anonymous": False, "steps": [{"sleep": 60}]}, name="victim")
+    mon = ros.monitor(spec(tmp_path, "entity n: /victim { rules: dead: not alive(node /victim); }\n"
+                                     "if (n.dead) then { stop; }\n"), node_rate=10)
+    listener = listen_until_stopped(ros, "/safety_cmd", TWIST)
+    time.sleep(0.5)
+    hung = time.time()
+    os.kill(victim.pid, signal.SIGSTOP)  # it keeps its sockets: only the getPid timeout finds it
+    try:
+        rec = records(listener)
+    finally:
+        os.kill(victim.pid, signal.SIGCONT)
+    stop = first(rec, "recv", "/safety_cmd")
+    assert stop is not None, ros.log(mon)
+    assert 0 < stop["wall"] - hung < 0.1 + 0.1 + 0.1 + 0.05  # a sample, the 100 ms timeout, +100 ms, slack

@@ -61,3 +61,40 @@ def test_bad_row_name_is_a_usage_error():
     proc = subprocess.run([sys.executable, "-m", "rubass", "experiments", "--only", "Nope"], cwd=ROOT,
                           capture_output=True, text=True, timeout=60)
     assert proc.returncode == 2 and "no row 'Nope'" in proc.stderr
+
+
+def test_the_board_stops_the_motors_when_the_monitor_dies(ros, tmp_path):
+    """SIGKILL the monitor: its heartbeat stops, and the Frobit's safety board cuts the motors
+    after its watchdog time (0.25 s) with nothing else telling it to."""
+    import signal
+    import time
+
+    from rubass.ros.sim.eventlog import read_events
+
+    events = tmp_path / "events.jsonl"
+    board = tmp_path / "board"
+    base = ros.spawn([sys.executable, "-m", "rubass.ros.sim.frobit", "__name:=frobit_base",
+                      f"_events_file:={events}", f"_board_port:={board}"], "base")
+    ros.spawn([sys.executable, "-m", "rubass.ros.sim.driver", "__name:=controller", "_robot:=frobit"], "driver")
+    lib = (tmp_path / "lib.yaml")
+    lib.write_text(f'actions:\n  board_stop: {{plugin: serial, port: {board}, on_start: "S\\n", latch: true}}\n')
+    spec = tmp_path / "s.rbs"
+    spec.write_text('import "lib.yaml";\naction primitive board_stop;\n'
+                    "entity w { rules: fast: topic /wheel_left/encoder.data > 5 m/s; }\nif (w.fast) then { board_stop; }\n")
+    end = time.time() + 10
+    while not board.exists() and time.time() < end:
+        time.sleep(0.05)
+    mon = ros.monitor(str(spec))
+    time.sleep(1.5)  # the board has seen heartbeats; the robot drives
+    assert not [e for e in read_events(str(events)) if e["event"] in ("watchdog_cut", "stop_received")]
+    killed = time.time()
+    os.kill(mon.pid, signal.SIGKILL)
+    end = time.time() + 5
+    cut = []
+    while not cut and time.time() < end:
+        cut = [e for e in read_events(str(events)) if e["event"] == "watchdog_cut"]
+        time.sleep(0.02)
+    assert cut, ros.log(base)
+    # counted from the last heartbeat, which came up to one tick (20 ms) before the kill
+    assert 0.25 <= cut[0]["silent_for"] < 0.25 + 0.02
+    assert 0.25 - 0.02 <= cut[0]["wall"] - killed < 0.25 + 0.05
