@@ -24,6 +24,7 @@ Signals
 """
 from __future__ import annotations
 
+import os
 import signal
 import sys
 import threading
@@ -65,7 +66,10 @@ class Monitor:
         self.reloads = 0
         self.rejected = 0
         self.last_reload_error = ""
-        self._reload_lock = threading.Lock()
+        self._reload_lock = threading.RLock()
+        self._pending_lock = threading.Lock()
+        self._reload_waiting = False
+        self.coalesced = 0
         self._stopping = False
         self._exit = threading.Event()
 
@@ -119,7 +123,7 @@ class Monitor:
         rospy.Service("~reload", Trigger, lambda req: TriggerResponse(*self.reload("service")))
         rospy.Service("~reset", Trigger, lambda req: TriggerResponse(*self.reset()))
         signal.signal(signal.SIGHUP, lambda signum, frame: threading.Thread(
-            target=self.reload, args=("SIGHUP",), name="rubass-reload", daemon=True).start())
+            target=self.reload_coalesced, args=("SIGHUP",), name="rubass-reload", daemon=True).start())
         # our own SIGINT/SIGTERM: release actions while publishers still work, then stop rospy
         # (after rospy's own handler, publish() silently does nothing)
         for sig in (signal.SIGINT, signal.SIGTERM):
@@ -163,13 +167,30 @@ class Monitor:
                 rospy.logerr_throttle(1, f"rubass: engine step failed: {exc.__class__.__name__}: {exc}")
 
     # -- control -------------------------------------------------------------------------
+    def reload_coalesced(self, reason: str) -> None:
+        """Reload, unless another request is already waiting behind the running reload: that
+        one will read the newest files anyway, so a storm of SIGHUPs costs at most two reloads."""
+        with self._pending_lock:
+            if self._reload_waiting:
+                self.coalesced += 1
+                return
+            self._reload_waiting = True
+        with self._reload_lock:
+            with self._pending_lock:
+                self._reload_waiting = False
+            self.reload(reason)
+
     def reload(self, reason: str) -> Tuple[bool, str]:
         """Re-read spec and libraries; swap atomically, or keep the old rules on any error."""
         with self._reload_lock:
             t0 = time.monotonic()
             try:
-                spec = load_spec(self.config.spec, self.config.actions)
+                spec = self._load_stable()
                 t_check = time.monotonic()
+                if spec.behaviours == [] and self.spec.behaviours:
+                    raise StartupError(f"{spec.path}: the new spec has no behaviours; refusing to drop every "
+                                       f"safety behaviour of the running spec (was the file caught half-written? "
+                                       f"to run without rules, restart the monitor)")
                 runners = self._runners(spec, self.runners)
             except (SpecError, StartupError) as exc:
                 text = exc.render() if isinstance(exc, SpecError) else str(exc)
@@ -200,6 +221,19 @@ class Monitor:
                           "swap %.1f ms)", spec.path, reason, ms, len(spec.rules), len(spec.behaviours),
                           (t_check - t0) * 1000, (t_build - t_check) * 1000, (t_swap - t_build) * 1000)
             return True, f"reloaded in {ms:.0f} ms: {len(spec.rules)} rules, {len(spec.behaviours)} behaviours"
+
+    def _load_stable(self) -> CheckedSpec:
+        """load_spec, again if a file changed while it was read or within the last 50 ms (an
+        editor or a script still writing it): a half-written file must not become the rules."""
+        paths = [self.config.spec] + list(self.config.actions)
+        for _ in range(5):
+            before = _stamps(paths)
+            spec = load_spec(self.config.spec, self.config.actions)
+            files = paths + [lib for lib in spec.libraries if lib not in paths]
+            if _stamps(paths) == before and time.time() - _newest(_stamps(files)) > 0.05:
+                return spec
+            time.sleep(0.1)
+        return load_spec(self.config.spec, self.config.actions)
 
     def _swap(self, old: Engine, new: Engine, spec: CheckedSpec, runners: Dict[str, ActionRunner]) -> None:
         """On the engine's thread: nothing is evaluated between the old rules and the new."""
@@ -246,6 +280,7 @@ class Monitor:
         lat = sorted(self.dispatcher.latencies)
         monitor: Dict[str, Any] = {
             "spec": self.spec.path, "reloads": self.reloads, "rejected reloads": self.rejected,
+            "coalesced reload requests": self.coalesced,
             "last reload error": self.last_reload_error, "dropped messages": self.loop.dropped,
             "action failures": failures,
             "reaction latency p50 ms": f"{lat[len(lat) // 2] * 1000:.3f}" if lat else "n/a",
@@ -284,6 +319,22 @@ class Monitor:
         for runner in self.runners.values():
             runner.stop(timeout=1.0)
             runner.plugin.close()
+
+
+def _stamps(paths: List[str]) -> List[Tuple[int, int]]:
+    """(mtime in ns, size) of each file; (0, -1) for one that cannot be read."""
+    out = []
+    for p in paths:
+        try:
+            st = os.stat(p)
+            out.append((st.st_mtime_ns, st.st_size))
+        except OSError:
+            out.append((0, -1))
+    return out
+
+
+def _newest(stamps: List[Tuple[int, int]]) -> float:
+    return max((m for m, _ in stamps), default=0) / 1e9
 
 
 def main(argv: Optional[List[str]] = None) -> int:

@@ -358,3 +358,31 @@ def test_a_node_hung_with_sigstop_is_not_alive_within_a_sample_and_its_timeout(r
     stop = first(rec, "recv", "/safety_cmd")
     assert stop is not None, ros.log(mon)
     assert 0 < stop["wall"] - hung < 0.1 + 0.1 + 0.1 + 0.05  # a sample, the 100 ms timeout, +100 ms, slack
+
+
+def test_a_storm_of_sighups_costs_at_most_two_reloads_and_the_newest_spec_wins(ros, tmp_path):
+    filler = "".join(f"  f{i}: (topic /filler_{i % 20}.data > {i}) for 1 s;\n" for i in range(1000))
+    body = ("entity base {{ rules: fast: topic /cmd_vel.linear.x > {} m/s; }}\nentity filler {{ rules:\n" + filler +
+            "}}\nif (base.fast) then {{ brake; }}\n")
+    mon = ros.monitor(spec(tmp_path, body.format(1.0)))
+    for limit in range(2, 22):  # rewritten in place (truncated first), as a script would
+        spec(tmp_path, body.format(float(limit)))
+        os.kill(mon.pid, signal.SIGHUP)
+        time.sleep(0.01)
+    spec(tmp_path, body.format(3.0))
+    os.kill(mon.pid, signal.SIGHUP)
+    time.sleep(6.0)
+    log = ros.log(mon)
+    assert 1 <= log.count("rubass: reloaded") <= 3, log
+    assert "reloaded" in log and ": 0 rules" not in log
+    assert not brake_after(ros, 2.0), "the newest spec (3 m/s) is enforced"
+    assert brake_after(ros, 4.0)
+
+
+def test_a_reload_that_would_drop_every_behaviour_is_refused(ros, tmp_path):
+    path = spec(tmp_path, "entity a { rules: r: topic /x.data > 1; }\nif (a.r) then { brake; }\n")
+    mon = ros.monitor(path)
+    (tmp_path / "s.rbs").write_text("")  # an empty file is a valid spec: it must not become the rules
+    out = ros.call("/rubass/reload")
+    assert "success: False" in out.stdout and "refusing to drop every safety behaviour" in out.stdout
+    assert mon.poll() is None
