@@ -90,6 +90,8 @@ class EngineLoop:
     def step(self, max_wait: Optional[float] = None) -> None:
         """Wait for an input or the next wake-up, then handle everything that is due."""
         now = self.clock()
+        if self._next_tick > now + 2 * self.period:  # the clock jumped back (sim time restarted, NTP)
+            self._next_tick = now + self.period
         wake = self._next_tick
         deadline = self.engine.next_deadline()
         if deadline is not None and deadline < wake:
@@ -111,9 +113,8 @@ class EngineLoop:
             self._emit(self.engine.on_tick(now), None)
             if self.tick_hook is not None:
                 self.tick_hook(now)
-            missed = int((now - self._next_tick) / self.period)
-            self._next_tick += (missed + 1) * self.period
-            if missed > 0 or self._next_tick > now + 2 * self.period:  # the clock jumped (sim time, NTP)
+            self._next_tick += self.period
+            if self._next_tick <= now:  # ticks were missed (a stall): go on from now, no burst
                 self._next_tick = now + self.period
 
     def _handle(self, item: Any) -> None:

@@ -59,3 +59,32 @@ def test_full_queue_counts_drops_instead_of_blocking():
     loop = EngineLoop(Engine(spec, 0.0), lambda: 0.0, 50.0, lambda events, cause: None, max_queue=3)
     assert [loop.submit(Message("/x", 0.0, {"data": 1})) for _ in range(5)] == [True, True, True, False, False]
     assert loop.dropped == 2
+
+
+def test_ticks_go_on_when_the_clock_jumps_back():
+    """Sim time restarting (a looping bag) must not stall ticks, and with them the heartbeat."""
+    spec = check_text("action primitive warn;\nentity a { rules: r: topic /x.data > 1; }\nif (a.r) then { warn; }\n",
+                      os.path.join(ROOT, "x.rbs"), [LIB])
+    now = [100.0]
+    ticks = []
+    loop = EngineLoop(Engine(spec, 100.0), lambda: now[0], 50.0, lambda events, cause: None,
+                      tick_hook=ticks.append)
+    now[0] = 100.03
+    loop.step(max_wait=0)
+    now[0] = 5.0  # back by 95 s
+    loop.step(max_wait=0)
+    now[0] = 5.03
+    loop.step(max_wait=0)
+    assert ticks == [100.03, 5.03]
+
+
+def test_a_stall_resumes_ticking_without_a_burst():
+    spec = check_text("action primitive warn;\nentity a { rules: r: topic /x.data > 1; }\nif (a.r) then { warn; }\n",
+                      os.path.join(ROOT, "x.rbs"), [LIB])
+    now = [0.0]
+    ticks = []
+    loop = EngineLoop(Engine(spec, 0.0), lambda: now[0], 50.0, lambda events, cause: None, tick_hook=ticks.append)
+    now[0] = 1.0  # 50 ticks late
+    loop.step(max_wait=0)
+    loop.step(max_wait=0)
+    assert ticks == [1.0]
