@@ -4,9 +4,11 @@ from __future__ import annotations
 import argparse
 import os
 import sys
-from typing import Callable, Dict, List, Optional, Sequence
+from typing import List, Optional, Sequence
 
 from .lang import SpecError, format_spec, load_spec, parse_source
+from .replay.command import register as register_replay
+from .ros.sim.command import register as register_experiments
 from .lang.errors import Diagnostic
 from .lang.source import SourceSet
 from .lang.sourcefile import read_source
@@ -66,7 +68,7 @@ def cmd_fmt(args: argparse.Namespace) -> int:
 
 
 def _parser() -> argparse.ArgumentParser:
-    p = argparse.ArgumentParser(prog="rubass", description="RuBaSS safety specs: check, format, replay.")
+    p = argparse.ArgumentParser(prog="rubass", description="RuBaSS safety specs: check, format, replay; the paper's experiments.")
     sub = p.add_subparsers(dest="command", metavar="COMMAND")
     c = sub.add_parser("check", help="check specs for errors")
     c.add_argument("spec", nargs="+", metavar="SPEC")
@@ -80,31 +82,9 @@ def _parser() -> argparse.ArgumentParser:
     g.add_argument("--check", action="store_true", help="exit 1 if the file is not in canonical layout")
     g.add_argument("--write", action="store_true", help="rewrite the file in place")
     f.set_defaults(func=cmd_fmt)
-    for name, register in _EXTRA_COMMANDS.items():
-        register(sub)
+    register_replay(sub)
+    register_experiments(sub)
     return p
-
-
-def _register_replay(sub: "argparse._SubParsersAction[argparse.ArgumentParser]") -> None:
-    try:
-        from .replay.command import register
-    except ImportError:  # the replay module comes with the engine
-        return
-    register(sub)
-
-
-def _register_experiments(sub: "argparse._SubParsersAction[argparse.ArgumentParser]") -> None:
-    try:
-        from .ros.sim.command import register
-    except ImportError:
-        return
-    register(sub)
-
-
-_EXTRA_COMMANDS: Dict[str, Callable[..., None]] = {
-    "replay": _register_replay,
-    "experiments": _register_experiments,
-}
 
 
 def main(argv: Optional[List[str]] = None) -> int:

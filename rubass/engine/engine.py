@@ -50,14 +50,6 @@ class _Behaviour:
         self.actions = tuple(a.name for a in checked.actions)
 
 
-def _walk(expr: ast.Expr) -> Iterable[ast.Expr]:
-    stack = [expr]
-    while stack:
-        e = stack.pop()
-        yield e
-        stack.extend(ast.children(e))
-
-
 class Engine:
     """Evaluates one checked spec over time."""
 
@@ -84,7 +76,7 @@ class Engine:
         direct: List[Tuple[Set[str], Set[str], bool]] = []
         for expr in [r.expr for r in spec.rules] + [b.cond for b in spec.behaviours]:
             topics, nodes, timed = set(), set(), False
-            for e in _walk(expr):
+            for e in ast.walk(expr):
                 if isinstance(e, ast.TopicRef):
                     topics.add(e.topic)
                 elif isinstance(e, ast.NodeRef):
@@ -98,7 +90,6 @@ class Engine:
             direct.append((topics, nodes, timed))
         for topic in spec.topics:
             self.store.watch(topic, now, windows.get(topic, 0.0))
-        self._windows = windows
         self._users = self._rule_users(spec)
         n = len(self._rules)
         self._topic_plans = {t: self._plan([i for i, d in enumerate(direct) if t in d[0]]) for t in spec.topics}
@@ -115,7 +106,7 @@ class Engine:
             for dep in r.rule_deps:
                 users[self._index[dep]].add(i)
         for j, b in enumerate(spec.behaviours):
-            for e in _walk(b.cond):
+            for e in ast.walk(b.cond):
                 if isinstance(e, ast.RuleRef):
                     users[self._index[e.key]].add(n + j)
         return users
@@ -305,7 +296,7 @@ class Engine:
     def behaviour_rules(self, index: int) -> List[str]:
         """The rules a behaviour's condition names that are true now (what caused it)."""
         cond = self._behaviours[index - 1].checked.cond
-        keys = [e.key for e in _walk(cond) if isinstance(e, ast.RuleRef)]
+        keys = [e.key for e in ast.walk(cond) if isinstance(e, ast.RuleRef)]
         return sorted({k for k in keys if self.store.rules.get(k) is True})
 
     def active_behaviours(self) -> List[int]:

@@ -118,10 +118,7 @@ class Compiler:
         inner = self._fn(expr, timers)
         ages: List[Tuple[str, float]] = []
         freqs: List[Tuple[str, float]] = []
-        stack = [expr]
-        while stack:
-            e = stack.pop()
-            stack.extend(ast.children(e))
+        for e in ast.walk(expr):
             if isinstance(e, ast.Call) and e.func == "frequency":
                 window = e.args[1].value if len(e.args) > 1 else 1.0  # type: ignore[union-attr]
                 freqs.append((e.args[0].topic, float(window)))  # type: ignore[union-attr,arg-type]

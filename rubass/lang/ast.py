@@ -6,7 +6,7 @@ wherever their layout differs.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Optional, Tuple, Union
+from typing import Iterator, Optional, Tuple, Union
 
 from .source import NO_SPAN, Span
 
@@ -189,6 +189,15 @@ class Spec:
     decls: Tuple[Decl, ...]
     comments: Tuple[Comment, ...] = field(default=(), compare=False)
     file: str = field(default="<string>", compare=False)
+
+
+def walk(expr: Expr) -> Iterator[Expr]:
+    """The expression and every sub-expression in it."""
+    stack = [expr]
+    while stack:
+        e = stack.pop()
+        yield e
+        stack.extend(children(e))
 
 
 def children(expr: Expr) -> Tuple[Expr, ...]:

@@ -291,24 +291,15 @@ def _sign_behaviours(behaviours: List[CheckedBehaviour], rules: List[CheckedRule
     sigs = {r.key: r.signature for r in rules}
     out = []
     for b in behaviours:
-        keys = sorted({e.key for e in _walk(b.cond) if isinstance(e, ast.RuleRef)})
+        keys = sorted({e.key for e in ast.walk(b.cond) if isinstance(e, ast.RuleRef)})
         out.append(dataclasses.replace(b, signature=b.signature + "".join(f" [{k}: {sigs[k]}]" for k in keys)))
-    return out
-
-
-def _walk(expr: ast.Expr) -> List[ast.Expr]:
-    out, stack = [], [expr]
-    while stack:
-        e = stack.pop()
-        out.append(e)
-        stack.extend(ast.children(e))
     return out
 
 
 def _uses(exprs: Sequence[ast.Expr]) -> Tuple[Dict[str, TopicUse], FrozenSet[str]]:
     paths: Dict[str, Set[Tuple[ast.PathElem, ...]]] = {}
     nodes: Set[str] = set()
-    for e in (x for expr in exprs for x in _walk(expr)):
+    for e in (x for expr in exprs for x in ast.walk(expr)):
         if isinstance(e, ast.TopicRef):
             paths.setdefault(e.topic, set())
             if e.path:

@@ -84,10 +84,7 @@ class CheckedSpec:
         owners = [(f"rule '{r.key}'", r.expr) for r in self.rules] + \
                  [(f"behaviour {b.index} (line {b.span.line})", b.cond) for b in self.behaviours]
         for owner, expr in owners:
-            stack = [expr]
-            while stack:
-                e = stack.pop()
-                stack.extend(ast.children(e))
+            for e in ast.walk(expr):
                 if isinstance(e, ast.TopicRef) and e.path:
                     users = out[e.topic].setdefault(e.path, [])
                     if owner not in users:

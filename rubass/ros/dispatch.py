@@ -79,8 +79,12 @@ class Dispatcher:
             "latency_ms": None if latency is None else round(latency * 1000.0, 3),
         })
 
+    def release(self, b: CheckedBehaviour, key: Any, now: float) -> None:
+        """Release a behaviour's actions outside an engine event (reload, reset, shutdown)."""
+        self.send("release", b, Context(b.index, b.span.line, (), (), now, key))
+
     def release_orphans(self, now: float) -> None:
         """Release latched actions of behaviours that a reload removed (called by ~reset)."""
         for b, key in self.orphans:
-            self.send("release", b, Context(b.index, b.span.line, (), (), now, key))
+            self.release(b, key, now)
         self.orphans = []

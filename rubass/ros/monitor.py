@@ -39,7 +39,7 @@ from ..engine.loop import EngineLoop, Message, NodeSample
 from ..lang import SpecError, load_spec
 from ..lang.model import CheckedSpec
 from . import status as status_mod
-from .actions.base import ActionSetupError, Context, make_plugin
+from .actions.base import ActionSetupError, make_plugin
 from .actions.runner import ActionRunner
 from .dispatch import Dispatcher
 from .nodes import NodeSampler
@@ -239,13 +239,13 @@ class Monitor:
         """On the engine's thread: nothing is evaluated between the old rules and the new."""
         now = _ros_now()
         events = new.adopt(old, now)
-        old_keys = Dispatcher.keys(old.spec.behaviours)
+        old_keys = self.dispatcher.keys_of(old.spec)
         for orphan in new.orphans:
             b = orphan.checked
             if b.latched:
                 self.dispatcher.orphans.append((b, old_keys[b.index]))
             else:
-                self.dispatcher.send("release", b, Context(b.index, b.span.line, (), (), now, old_keys[b.index]))
+                self.dispatcher.release(b, old_keys[b.index], now)
         self.dispatcher.runners = runners
         self.loop.engine = new
         self.dispatcher.handle(new, events, "reload")
@@ -298,11 +298,11 @@ class Monitor:
         now = _ros_now()
 
         def release(engine: Engine) -> None:
-            keys = Dispatcher.keys(engine.spec.behaviours)
+            keys = self.dispatcher.keys_of(engine.spec)
             for index in engine.active_behaviours():
                 b = engine.spec.behaviours[index - 1]
                 if not b.latched:
-                    self.dispatcher.send("release", b, Context(index, b.span.line, (), (), now, keys[index]))
+                    self.dispatcher.release(b, keys[index], now)
 
         rospy.loginfo("rubass: stopping: releasing non-latched actions")
         try:

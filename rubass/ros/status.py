@@ -10,7 +10,7 @@ from typing import Any, Dict, List, Tuple
 from ..lang import ast
 from ..lang.model import CheckedSpec
 
-OK, WARN, ERROR, STALE = 0, 1, 2, 3
+OK, WARN, ERROR = 0, 1, 2  # DiagnosticStatus levels
 
 
 @dataclass
@@ -29,10 +29,7 @@ def unknown_reasons(spec: CheckedSpec, rule_key: str, topics: Dict[str, Dict[str
                     nodes: Dict[str, Dict[str, Any]], field_errors: Dict[Tuple[str, str], str]) -> List[str]:
     """Why a rule may be unknown: silent topics, bad fields, unmeasurable nodes."""
     why: List[str] = []
-    stack = [spec.rule(rule_key).expr]
-    while stack:
-        e = stack.pop()
-        stack.extend(ast.children(e))
+    for e in ast.walk(spec.rule(rule_key).expr):
         if isinstance(e, ast.TopicRef) and e.path:
             t = topics.get(e.topic, {})
             if not t.get("messages"):

@@ -38,11 +38,6 @@ class TopicState:
     cls: Any = None
 
 
-def field_users(spec: CheckedSpec) -> Dict[str, Dict[Tuple[ast.PathElem, ...], List[str]]]:
-    """topic -> field path -> the rules and behaviours that read it."""
-    return spec.field_readers()
-
-
 class TopicWatcher:
     def __init__(self, submit: Submit, log: Log) -> None:
         self.submit = submit
@@ -54,7 +49,7 @@ class TopicWatcher:
     def sync(self, spec: CheckedSpec) -> None:
         """Subscribe to the spec's topics, unsubscribe from those it no longer names."""
         wanted = {rospy.resolve_name(t): t for t in spec.topics}
-        users = field_users(spec)
+        users = spec.field_readers()
         with self._lock:
             for resolved in [r for r in self.topics if r not in wanted]:
                 state = self.topics.pop(resolved)

@@ -1,8 +1,6 @@
 """Integration-test harness: a private rosmaster per test, the monitor and probes as processes."""
 import json
 import os
-import signal
-import socket
 import subprocess
 import time
 
@@ -14,43 +12,20 @@ PROBE = os.path.join(ROOT, "test", "integration", "probe.py")
 PY = "/usr/bin/python3"
 
 
-def free_port():
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
-
-
 class Ros:
-    """A master on a free port and the environment every process of the test gets."""
+    """A private master on a free port (rubass's own PrivateMaster) and the environment every
+    process of the test gets."""
 
     def __init__(self, tmp_path):
         if not os.path.exists("/usr/bin/rosmaster"):
             pytest.skip("ROS 1 is not installed (rosmaster)")
+        from rubass.ros.master import PrivateMaster
+
         self.tmp = tmp_path
-        self.port = free_port()
-        self.env = dict(os.environ, ROS_MASTER_URI=f"http://127.0.0.1:{self.port}", ROS_IP="127.0.0.1",
-                        ROS_HOME=str(tmp_path / "ros_home"), ROS_LOG_DIR=str(tmp_path / "ros_log"),
-                        PYTHONPATH=ROOT + os.pathsep + os.environ.get("PYTHONPATH", ""),
-                        PYTHONDONTWRITEBYTECODE="1", PYTHONUNBUFFERED="1")
-        self.env.pop("ROS_HOSTNAME", None)
+        self.master = PrivateMaster(str(tmp_path / "ros_home"))
+        self.port = self.master.port
+        self.env = dict(self.master.env, ROS_LOG_DIR=str(tmp_path / "ros_log"), PYTHONUNBUFFERED="1")
         self.procs = []
-        self.master = self.spawn(["rosmaster", "--core", "-p", str(self.port)], "master")
-        self.wait_master()
-
-    def wait_master(self, timeout=10.0):
-        import rosgraph
-
-        end = time.time() + timeout
-        while time.time() < end:
-            if rosgraph.is_master_online(f"http://127.0.0.1:{self.port}"):
-                # roscore sets /run_id; roslaunch waits for it; a bare rosmaster does not set it
-                import uuid
-
-                rosgraph.Master("/test", master_uri=f"http://127.0.0.1:{self.port}").setParam(
-                    "/run_id", str(uuid.uuid1()))
-                return
-            time.sleep(0.05)
-        raise RuntimeError("rosmaster did not come up")
 
     def spawn(self, cmd, name, **kw):
         log = open(self.tmp / f"{name}.log", "w")
@@ -102,15 +77,7 @@ class Ros:
         return open(proc.log_path).read() if os.path.exists(proc.log_path) else ""
 
     def stop(self):
-        for proc in reversed(self.procs):
-            if proc.poll() is None:
-                try:
-                    os.killpg(proc.pid, signal.SIGTERM)
-                except ProcessLookupError:
-                    pass
-        for proc in reversed(self.procs):
-            try:
-                proc.wait(5)
-            except subprocess.TimeoutExpired:
-                os.killpg(proc.pid, signal.SIGKILL)
-                proc.wait(5)
+        from rubass.ros.master import stop_processes
+
+        stop_processes(list(reversed(self.procs)))
+        self.master.stop()

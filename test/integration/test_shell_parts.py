@@ -86,13 +86,13 @@ def test_a_topic_that_changes_type_is_reported_and_its_fields_rechecked():
     import rospy
     from std_msgs.msg import Float64, String
 
-    from rubass.ros.topics import TopicState, TopicWatcher, field_users
+    from rubass.ros.topics import TopicState, TopicWatcher
 
     rospy.rostime.set_rostime_initialized(True)
     spec = check_text("entity a { rules: r: topic /x.data > 1; }\n", "/tmp/x.rbs")
     got, logs = [], []
     watcher = TopicWatcher(lambda *a: got.append(a), lambda level, text: logs.append(text))
-    state = TopicState("/x", "/x", field_users(spec)["/x"])
+    state = TopicState("/x", "/x", spec.field_readers()["/x"])
 
     def raw(msg):
         buf = io.BytesIO()

@@ -34,7 +34,6 @@ class ActionStats:
     calls: int = 0
     failures: int = 0
     last_error: str = ""
-    last_call_s: float = 0.0
     extra: Dict[str, Any] = field(default_factory=dict)
 
 

@@ -136,7 +136,6 @@ class ActionRunner:
                 return  # at shutdown a release is tried a few times, not forever
 
     def _guard(self, what: str, fn: Callable[[], None]) -> bool:
-        t0 = time.monotonic()
         try:
             fn()
         except Exception as exc:  # a plugin's failure must never reach the engine
@@ -148,8 +147,6 @@ class ActionRunner:
                 self.log("error", f"action '{self.plugin.name}' {what} failed ({self.stats.failures} failures so "
                                   f"far; retrying): {exc.__class__.__name__}: {exc}")
             return False
-        finally:
-            self.stats.last_call_s = time.monotonic() - t0
         if what != "periodic":
             self.stats.calls += 1
         return True
