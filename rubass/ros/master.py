@@ -25,6 +25,9 @@ class PrivateMaster:
                                         PYTHONPATH=ROOT + os.pathsep + os.environ.get("PYTHONPATH", ""),
                                         PYTHONDONTWRITEBYTECODE="1")
         self.env.pop("ROS_HOSTNAME", None)
+        self._start()
+
+    def _start(self) -> None:
         self.process = subprocess.Popen(["rosmaster", "--core", "-p", str(self.port)], env=self.env,
                                         stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True)
         import rosgraph
@@ -35,8 +38,16 @@ class PrivateMaster:
                 self.stop()
                 raise RuntimeError(f"rosmaster did not start on port {self.port}")
             time.sleep(0.05)
+        self.online_at = time.time()  # when it first answered
         # roscore sets /run_id, and roslaunch waits for it; a bare rosmaster does not
         rosgraph.Master("/rubass", master_uri=self.uri).setParam("/run_id", str(uuid.uuid1()))
+
+    def restart(self, down: float = 0.0) -> None:
+        """Kill the master (SIGKILL, as a crash would), wait `down` seconds, start a new one on
+        the same port: it knows no node, topic or parameter."""
+        stop_processes([self.process], signal.SIGKILL)
+        time.sleep(down)
+        self._start()
 
     def join(self) -> None:
         """Make this process a client of the master (before rospy.init_node)."""

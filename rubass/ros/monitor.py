@@ -8,6 +8,8 @@ Parameters (private)
     ~rate (Hz, default 50)        scheduler ticks: `hold`, `age`/`frequency` re-evaluation, heartbeat
     ~node_rate (Hz, default 10)   node samples for alive(), cpu(), memory()
     ~diagnostics_rate (Hz, 1)     /diagnostics publications
+    ~master_rate (Hz, default 4)  checks that the master still knows the monitor (re-registers
+                                  after a master restart: docs/monitor.md)
 Subscribes
     every topic the spec names, whatever its type (rospy.AnyMsg, tcp_nodelay)
 Publishes
@@ -31,6 +33,7 @@ import threading
 import time
 from typing import Any, Dict, List, Optional, Tuple
 
+import rosgraph
 import rospy
 from std_srvs.srv import Trigger, TriggerResponse
 
@@ -42,6 +45,7 @@ from . import status as status_mod
 from .actions.base import ActionSetupError, make_plugin
 from .actions.runner import ActionRunner
 from .dispatch import Dispatcher
+from .master_watch import MasterWatch
 from .nodes import NodeSampler
 from .outputs import Outputs
 from .params import MonitorConfig, ParamError, read_config
@@ -120,6 +124,8 @@ class Monitor:
         self.watcher = TopicWatcher(self._on_message, _log)
         self.watcher.sync(spec)
         self.sampler = self._sampler(spec)
+        self.master_watch = MasterWatch(rospy.get_caller_id(), rospy.core.get_node_uri(), rosgraph.get_master_uri(),
+                                        1.0 / self.config.master_rate, _log)
         rospy.Service("~reload", Trigger, lambda req: TriggerResponse(*self.reload("service")))
         rospy.Service("~reset", Trigger, lambda req: TriggerResponse(*self.reset()))
         signal.signal(signal.SIGHUP, lambda signum, frame: threading.Thread(
@@ -128,6 +134,7 @@ class Monitor:
         # (after rospy's own handler, publish() silently does nothing)
         for sig in (signal.SIGINT, signal.SIGTERM):
             signal.signal(sig, lambda signum, frame: self._exit.set())
+        self.master_watch.start()
         rospy.loginfo("rubass: enforcing %s (%d rules, %d behaviours, %d topics, %d nodes)", spec.path,
                       len(spec.rules), len(spec.behaviours), len(spec.topics), len(spec.nodes))
 
@@ -283,6 +290,7 @@ class Monitor:
             "coalesced reload requests": self.coalesced,
             "last reload error": self.last_reload_error, "dropped messages": self.loop.dropped,
             "action failures": failures,
+            "master": self.master_watch.state, "master re-registrations": self.master_watch.reregistrations,
             "reaction latency p50 ms": f"{lat[len(lat) // 2] * 1000:.3f}" if lat else "n/a",
         }
         for name, r in self.runners.items():
@@ -310,6 +318,7 @@ class Monitor:
         except Exception as exc:  # the engine thread is stuck: stop anyway
             rospy.logerr(f"rubass: could not release actions at shutdown: {exc}")
         self._stopping = True
+        self.master_watch.stop()
         self.loop.stop()
         self.sampler.stop()
         received = sum(st.messages for st in self.watcher.status())

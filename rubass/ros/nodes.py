@@ -19,6 +19,7 @@ import psutil
 import rosgraph
 
 from ..engine.values import UNKNOWN
+from . import rpc
 
 Submit = Callable[[str, float, Any, Any, Any], None]  # (spec node, ROS time, alive, cpu, memory)
 
@@ -38,17 +39,6 @@ def _schedstat_seconds(pid: int) -> Optional[float]:
     except OSError:
         return None
     return total / 1e9
-
-
-class _TimeoutTransport(xmlrpc.client.Transport):
-    def __init__(self, timeout: float) -> None:
-        super().__init__()
-        self.timeout = timeout
-
-    def make_connection(self, host: Any) -> Any:
-        conn = super().make_connection(host)
-        conn.timeout = self.timeout
-        return conn
 
 
 @dataclass
@@ -75,9 +65,11 @@ class NodeSampler:
         self.status: Dict[str, NodeStatus] = {r: NodeStatus(n, r) for n, r in nodes}
         self.submit, self.now, self.period, self.timeout = submit, now, period, timeout
         self.caller_id = caller_id
+        self.master_uri = rosgraph.get_master_uri()
         self._procs: Dict[int, psutil.Process] = {}
         self._cpu_last: Dict[int, Tuple[float, float]] = {}
         self._uris: Dict[str, str] = {}
+        self._pids: Dict[str, int] = {}  # last pid seen per node, to recognise it without the master
         self._local = _local_addresses()
         self._hosts: Dict[str, bool] = {}
         self._stop = threading.Event()
@@ -107,38 +99,51 @@ class NodeSampler:
             self._stop.wait(max(0.0, delay))
 
     def sample(self, st: NodeStatus) -> None:
-        alive, pid, why = self._ask(st.resolved)
+        alive, pid, why = self._ask(st)
         cpu: Any = UNKNOWN
         memory: Any = UNKNOWN
         if alive is True and pid is not None:
             uri = self._uris.get(st.resolved, "")
             if self._is_local(urlparse(uri).hostname or ""):
+                note = why[len("alive"):]
                 cpu, memory, why = self._measure(pid)
+                why += note
             else:
                 why = f"on host {urlparse(uri).hostname}, not this one: cpu and memory are unknown"
         st.alive, st.cpu, st.memory, st.pid, st.why = alive, cpu, memory, pid, why
         self.submit(st.spec_name, self.now(), alive, cpu, memory)
 
-    def _ask(self, name: str) -> Tuple[Any, Optional[int], str]:
-        try:
-            uri = rosgraph.Master(self.caller_id).lookupNode(name)
-            self._uris[name] = uri
-        except rosgraph.MasterError:
-            return False, None, "not registered with the master"
+    def _ask(self, st: NodeStatus) -> Tuple[Any, Optional[int], str]:
+        name = st.resolved
+        note = ""
+        try:  # the master with a timeout too: a hung master must not stall every sample
+            code, msg, uri = rpc.proxy(self.master_uri, max(self.timeout, 0.5)).lookupNode(self.caller_id, name)
         except (OSError, socket.error, xmlrpc.client.Error) as exc:
+            code, msg, uri = -2, str(exc), None
+        if code == 1:
+            self._uris[name] = uri
+        else:
             uri = self._uris.get(name)
             if uri is None:
-                return UNKNOWN, None, f"the master cannot be reached ({exc}) and the node was never seen"
+                if code == -2:
+                    return UNKNOWN, None, f"the master cannot be reached ({msg}) and the node was never seen"
+                return False, None, "not registered with the master"
+            # the master is down, or restarted and does not know the node (rospy nodes do not
+            # re-register): ask the node where it was; alive only if it is the same process
+            note = " (the master cannot be reached)" if code == -2 else " (not registered with the master: restarted?)"
         try:
-            proxy = xmlrpc.client.ServerProxy(uri, transport=_TimeoutTransport(self.timeout))
-            code, msg, pid = proxy.getPid(self.caller_id)
+            code, msg, pid = rpc.proxy(uri, self.timeout).getPid(self.caller_id)
         except socket.timeout:
             return False, None, f"did not answer getPid within {self.timeout * 1000:.0f} ms (hung?)"
         except (OSError, xmlrpc.client.Error, ValueError) as exc:
             return False, None, f"does not answer at {uri}: {exc}"
         if code != 1:
             return False, None, f"getPid failed: {msg}"
-        return True, int(pid), "alive"
+        known = self._pids.get(name)
+        if note and known is not None and int(pid) != known:
+            return False, None, f"another process (pid {pid}) answers at {uri}{note}"
+        self._pids[name] = int(pid)
+        return True, int(pid), "alive" + note
 
     def _is_local(self, host: str) -> bool:
         if host not in self._hosts:

@@ -22,6 +22,7 @@ class MonitorConfig:
     rate: float = 50.0       # scheduler ticks per second
     node_rate: float = 10.0  # node samples per second
     diagnostics_rate: float = 1.0
+    master_rate: float = 4.0  # checks per second that the master still knows the monitor
 
 
 def _rate(get: Getter, name: str, default: float, lo: float, hi: float) -> float:
@@ -56,4 +57,5 @@ def read_config(get: Getter) -> MonitorConfig:
         rate=_rate(get, "rate", 50.0, 1.0, 1000.0),
         node_rate=_rate(get, "node_rate", 10.0, 0.1, 100.0),
         diagnostics_rate=_rate(get, "diagnostics_rate", 1.0, 0.1, 10.0),
+        master_rate=_rate(get, "master_rate", 4.0, 0.1, 100.0),
     )

@@ -81,3 +81,58 @@ class Ros:
 
         stop_processes(list(reversed(self.procs)))
         self.master.stop()
+
+
+LIB = """actions:
+  stop: {plugin: publish, topic: /safety_cmd, type: geometry_msgs/Twist, message: {}, rate: 20 Hz, latch: true}
+  brake: {plugin: publish, topic: /brake, type: std_msgs/Bool, message: {data: true}, rate: 20 Hz}
+  warn: {plugin: log, level: warn}
+"""
+TWIST = "geometry_msgs/Twist"
+
+
+def spec(tmp_path, body, lib=LIB, name="s.rbs"):
+    (tmp_path / "lib.yaml").write_text(lib)
+    path = tmp_path / name
+    path.write_text('import "lib.yaml";\naction primitive stop, brake, warn;\n' + body)
+    return str(path)
+
+
+def first(records, kind, topic):
+    return next((r for r in records if r["kind"] == kind and r["topic"] == topic), None)
+
+
+def listen_until_stopped(ros, topic, type_, name="listener", timeout=8):
+    """A background probe that says 'ready' once the monitor's publisher is up, then waits."""
+    proc = ros.probe_bg({"listen": [{"topic": topic, "type": type_}],
+                         "steps": [{"wait_publishers": topic}, {"sleep": 0.3}, {"mark": "ready"},
+                                   {"wait": topic, "timeout": timeout}], "linger": 0.1}, name=name)
+    line = proc.stdout.readline()
+    assert '"ready"' in line, line + ros.log(proc)
+    return proc
+
+
+def records(proc):
+    import json
+
+    out, _ = proc.communicate(timeout=30)
+    return [json.loads(line) for line in out.splitlines() if line.startswith("{")]
+
+
+def wait_log(proc, ros, text, timeout=10.0):
+    end = time.time() + timeout
+    while time.time() < end:
+        if text in ros.log(proc):
+            return True
+        time.sleep(0.05)
+    raise AssertionError(f"'{text}' never logged:\n{ros.log(proc)}")
+
+
+def brake_after(ros, value, wait=1.0):
+    """Publish /cmd_vel linear.x = value; the /brake messages that follow within `wait`."""
+    rec = ros.probe({"listen": [{"topic": "/brake", "type": "std_msgs/Bool"}],
+                     "advertise": [{"topic": "/cmd_vel", "type": TWIST}],
+                     "steps": [{"wait_subscribers": "/cmd_vel"}, {"sleep": 0.3}, {"mark": "go"},
+                               {"publish": "/cmd_vel", "msg": {"linear": {"x": value}}}, {"sleep": wait}]})
+    go = next(r["wall"] for r in rec if r["kind"] == "mark")
+    return [r for r in rec if r["kind"] == "recv" and r["wall"] > go and r["msg"]["data"] is True]

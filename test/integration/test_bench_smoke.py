@@ -39,7 +39,7 @@ def test_replay_throughput(tmp_path):
 
 
 @pytest.mark.ros
-@pytest.mark.parametrize("script", ["reaction.py", "timed.py", "scale.py", "reload.py"])
+@pytest.mark.parametrize("script", ["reaction.py", "timed.py", "scale.py", "reload.py", "master_restart.py"])
 def test_ros_benchmarks(script):
     if not os.path.exists("/usr/bin/rosmaster"):
         pytest.skip("ROS 1 is not installed")
@@ -49,3 +49,5 @@ def test_ros_benchmarks(script):
         assert rows[0]["raw_hop"]["n"] > 0 and rows[0]["rubass"]["n"] > 0
     if script == "reload.py":
         assert rows[0]["reloads"] == 2 and rows[0]["missed"] == 0
+    if script == "master_restart.py":
+        assert rows[0]["restarts"] == 1 and rows[0]["missed"] == 0 and rows[0]["blind_after_master_up_ms_max"] < 1000

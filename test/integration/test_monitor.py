@@ -7,28 +7,9 @@ import time
 import pytest
 
 from conftest import ROOT
-from rosharness import PY
+from rosharness import LIB, PY, TWIST, brake_after, first, listen_until_stopped, records, spec, wait_log
 
 pytestmark = pytest.mark.ros
-
-LIB = """actions:
-  stop: {plugin: publish, topic: /safety_cmd, type: geometry_msgs/Twist, message: {}, rate: 20 Hz, latch: true}
-  brake: {plugin: publish, topic: /brake, type: std_msgs/Bool, message: {data: true}, rate: 20 Hz}
-  warn: {plugin: log, level: warn}
-"""
-TWIST = "geometry_msgs/Twist"
-
-
-def spec(tmp_path, body, lib=LIB, name="s.rbs"):
-    (tmp_path / "lib.yaml").write_text(lib)
-    path = tmp_path / name
-    path.write_text('import "lib.yaml";\naction primitive stop, brake, warn;\n' + body)
-    return str(path)
-
-
-def first(records, kind, topic):
-    return next((r for r in records if r["kind"] == kind and r["topic"] == topic), None)
-
 
 def test_violation_publishes_the_stop(ros, tmp_path):
     ros.monitor(spec(tmp_path, "entity base { rules: fast: topic /cmd_vel.linear.x > 1.0 m/s; }\n"
@@ -57,23 +38,6 @@ def test_for_rule_fires_at_t0_plus_T(ros, tmp_path):
     stop = first(rec, "recv", "/safety_cmd")
     assert stop is not None
     assert stop["wall"] - t0 == pytest.approx(0.5, abs=0.02)
-
-
-def listen_until_stopped(ros, topic, type_, name="listener", timeout=8):
-    """A background probe that says 'ready' once the monitor's publisher is up, then waits."""
-    proc = ros.probe_bg({"listen": [{"topic": topic, "type": type_}],
-                         "steps": [{"wait_publishers": topic}, {"sleep": 0.3}, {"mark": "ready"},
-                                   {"wait": topic, "timeout": timeout}], "linger": 0.1}, name=name)
-    line = proc.stdout.readline()
-    assert '"ready"' in line, line + ros.log(proc)
-    return proc
-
-
-def records(proc):
-    import json
-
-    out, _ = proc.communicate(timeout=30)
-    return [json.loads(line) for line in out.splitlines() if line.startswith("{")]
 
 
 def test_sigkill_of_a_watched_node_turns_alive_false(ros, tmp_path):
@@ -114,25 +78,6 @@ def test_a_topic_that_appears_later_is_picked_up(ros, tmp_path):
                      "steps": [{"wait_subscribers": "/late"}, {"wait_publishers": "/safety_cmd"}, {"sleep": 0.3},
                                {"publish": "/late", "msg": {"data": 5}}, {"wait": "/safety_cmd", "timeout": 5}]})
     assert first(rec, "recv", "/safety_cmd") is not None
-
-
-def wait_log(proc, ros, text, timeout=10.0):
-    end = time.time() + timeout
-    while time.time() < end:
-        if text in ros.log(proc):
-            return True
-        time.sleep(0.05)
-    raise AssertionError(f"'{text}' never logged:\n{ros.log(proc)}")
-
-
-def brake_after(ros, value, wait=1.0):
-    """Publish /cmd_vel linear.x = value; the /brake messages that follow within `wait`."""
-    rec = ros.probe({"listen": [{"topic": "/brake", "type": "std_msgs/Bool"}],
-                     "advertise": [{"topic": "/cmd_vel", "type": TWIST}],
-                     "steps": [{"wait_subscribers": "/cmd_vel"}, {"sleep": 0.3}, {"mark": "go"},
-                               {"publish": "/cmd_vel", "msg": {"linear": {"x": value}}}, {"sleep": wait}]})
-    go = next(r["wall"] for r in rec if r["kind"] == "mark")
-    return [r for r in rec if r["kind"] == "recv" and r["wall"] > go and r["msg"]["data"] is True]
 
 
 def test_sighup_changes_what_is_enforced_and_a_broken_spec_changes_nothing(ros, tmp_path):

@@ -1,0 +1,133 @@
+"""Surviving a master restart.
+
+rospy registers a node's publishers, subscribers and services with the master once, when
+each is created, and never again: after the master restarts, the new master does not know
+the monitor, so nodes started afterwards (a restarted driver, a new base controller) never
+connect to it. Connections made before the restart are peer to peer and keep working.
+
+MasterWatch asks the master, a few times a second, whether it still knows this node
+(lookupNode of our own name, with a timeout). When it does not, it registers every
+publisher, subscriber and service of this process again, with the URIs they already have,
+and hands each subscription the new master's publisher list, as rospy does at start-up.
+Nothing is torn down, so the existing connections, the ones that carry the stop to the
+robot's base, are never interrupted.
+"""
+from __future__ import annotations
+
+import socket
+import threading
+import time
+import xmlrpc.client
+from dataclasses import dataclass
+from typing import Any, Callable, Optional, Tuple
+
+from rospy.impl.registration import RegManager, get_registration_listeners, get_service_manager, get_topic_manager
+
+from . import rpc
+
+Log = Callable[[str, str], None]
+
+
+@dataclass
+class Registered:
+    publishers: int
+    subscribers: int
+    services: int
+    ms: float
+
+
+def register_all(master: Any, caller_id: str, node_uri: str) -> Registered:
+    """Register this process's publishers, subscribers and services with `master` (an XML-RPC
+    proxy); connect the subscribers to the publishers it knows. IOError on a refusal."""
+    t0 = time.monotonic()
+    tm, sm = get_topic_manager(), get_service_manager()
+    with tm.lock, sm.lock:  # a consistent list; the calls below are made without the locks
+        pubs, subs, srvs = tm.get_publications(), tm.get_subscriptions(), sm.get_services()
+    manager = _reg_manager()
+    for name, type_name in pubs:
+        _ok(master.registerPublisher(caller_id, name, type_name, node_uri), "publisher", name)
+    for name, type_name in subs:
+        uris = _ok(master.registerSubscriber(caller_id, name, type_name, node_uri), "subscriber", name)
+        if manager is not None:
+            manager.publisher_update(name, uris)  # rospy connects to new publishers on its own thread
+    for name, service_uri in srvs:
+        _ok(master.registerService(caller_id, name, service_uri, node_uri), "service", name)
+    return Registered(len(pubs), len(subs), len(srvs), (time.monotonic() - t0) * 1000.0)
+
+
+def _ok(reply: Tuple[int, str, Any], kind: str, name: str) -> Any:
+    code, msg, value = reply
+    if code != 1:
+        raise IOError(f"the master refused to register {kind} {name}: {msg}")
+    return value
+
+
+def _reg_manager() -> Optional[RegManager]:
+    for listener in list(get_registration_listeners().listeners):
+        if isinstance(listener, RegManager):
+            return listener
+    return None
+
+
+class MasterWatch:
+    """Polls the master on a thread of its own; re-registers this node when the master has
+    forgotten it. `state` and the counters feed the monitor's /diagnostics."""
+
+    def __init__(self, caller_id: str, node_uri: str, master_uri: str, period: float, log: Log,
+                 timeout: float = 0.5) -> None:
+        self.caller_id, self.node_uri, self.master_uri = caller_id, node_uri, master_uri
+        self.period, self.timeout, self.log = period, timeout, log
+        self.state = "connected"
+        self.reregistrations = 0
+        self.last: Optional[Registered] = None
+        self.down_since: Optional[float] = None  # monotonic time of the first failed poll
+        self._stop = threading.Event()
+        self._thread: Optional[threading.Thread] = None
+
+    def start(self) -> None:
+        self._thread = threading.Thread(target=self._run, name="rubass-master", daemon=True)
+        self._thread.start()
+
+    def stop(self) -> None:
+        self._stop.set()
+        if self._thread is not None:
+            self._thread.join(2.0)
+
+    def _run(self) -> None:
+        while not self._stop.wait(self.period):
+            try:
+                self.check()
+            except Exception as exc:  # never let the watch die: log and poll again
+                self.log("error", f"master watch: {exc.__class__.__name__}: {exc}")
+
+    def check(self) -> str:
+        """One poll: 'ok', 'unreachable', 'foreign' (another node holds our name) or 're-registered'."""
+        master = rpc.proxy(self.master_uri, self.timeout)
+        try:
+            code, msg, uri = master.lookupNode(self.caller_id, self.caller_id)
+        except (OSError, socket.error, xmlrpc.client.Error) as exc:
+            if self.down_since is None:
+                self.down_since = time.monotonic()
+                self.log("warn", f"the master at {self.master_uri} cannot be reached ({exc}): existing connections "
+                                 f"keep working and the rules keep being enforced; nodes started now cannot "
+                                 f"connect to the monitor until the master is back")
+            self.state = f"unreachable for {time.monotonic() - self.down_since:.1f} s"
+            return "unreachable"
+        was_down = self.down_since
+        self.down_since = None
+        if code == 1 and uri == self.node_uri:
+            if was_down is not None:
+                self.log("info", f"the master at {self.master_uri} is back and still knows this node")
+            self.state = "connected"
+            return "ok"
+        if code == 1:  # rospy shuts a node down when another takes its name; do not fight over it
+            self.state = f"another node ({uri}) holds the name {self.caller_id}"
+            return "foreign"
+        reg = register_all(master, self.caller_id, self.node_uri)
+        self.reregistrations += 1
+        self.last = reg
+        self.state = "connected"
+        self.log("warn", f"the master at {self.master_uri} did not know this node (it restarted): registered "
+                         f"{reg.publishers} publishers, {reg.subscribers} subscribers and {reg.services} services "
+                         f"again in {reg.ms:.1f} ms")
+        return "re-registered"

@@ -1,0 +1,86 @@
+"""The monitor survives faults around it (issue #7): a master restart, ..."""
+import os
+import signal
+import time
+
+import pytest
+
+from rosharness import TWIST, first, listen_until_stopped, records, spec
+
+pytestmark = pytest.mark.ros
+
+FAST = "entity base { rules: fast: topic /cmd_vel.linear.x > 1.0 m/s; }\nif (base.fast) then { stop; }\n"
+
+
+def violate_and_wait_stop(ros):
+    """A node started now publishes a violation; the records of its stop (or timeout)."""
+    return ros.probe({"listen": [{"topic": "/safety_cmd", "type": TWIST}],
+                      "advertise": [{"topic": "/cmd_vel", "type": TWIST}],
+                      "steps": [{"wait_subscribers": "/cmd_vel", "timeout": 5},
+                                {"wait_publishers": "/safety_cmd", "timeout": 5}, {"sleep": 0.3},
+                                {"publish": "/cmd_vel", "msg": {"linear": {"x": 2.0}}},
+                                {"wait": "/safety_cmd", "timeout": 3}]})
+
+
+def monitor_registered(master, topic, node="/rubass"):
+    pubs, subs, srvs = master.getSystemState()
+    return any(t == topic and node in nodes for t, nodes in subs) and \
+        any(s == f"{node}/reset" for s, _ in srvs) and any(t == "/safety_cmd" and node in n for t, n in pubs)
+
+
+def test_after_a_master_restart_the_monitor_re_registers_and_still_stops_the_robot(ros, tmp_path):
+    import rosgraph
+
+    mon = ros.monitor(spec(tmp_path, FAST), master_rate=4)
+    before = listen_until_stopped(ros, "/safety_cmd", TWIST, name="before", timeout=30)
+    ros.master.restart(down=1.0)
+    master = rosgraph.Master("/test", master_uri=ros.master.uri)
+    while not monitor_registered(master, "/cmd_vel"):
+        assert time.time() - ros.master.online_at < 5, ros.log(mon)
+        time.sleep(0.01)
+    blind = time.time() - ros.master.online_at
+    assert blind < 0.25 + 0.25, f"re-registered {blind:.2f} s after the new master came up"  # a poll period + slack
+    # a driver started after the restart: its violation reaches the monitor, the stop reaches it
+    rec = violate_and_wait_stop(ros)
+    sent = first(rec, "sent", "/cmd_vel")
+    stop = first(rec, "recv", "/safety_cmd")
+    assert stop is not None, ros.log(mon)
+    assert stop["wall"] - sent["wall"] < 0.1
+    # the node connected before the restart keeps its peer-to-peer connection: it got the stop too
+    assert first(records(before), "recv", "/safety_cmd") is not None
+    assert "did not know this node (it restarted): registered" in ros.log(mon)
+    assert ros.call("/rubass/reset").returncode == 0, "the monitor's services are known to the new master"
+    assert mon.poll() is None
+
+
+def test_while_the_master_is_down_the_rules_keep_being_enforced(ros, tmp_path):
+    mon = ros.monitor(spec(tmp_path, FAST), master_rate=4)
+    driver = ros.probe_bg({"listen": [{"topic": "/safety_cmd", "type": TWIST}],
+                           "advertise": [{"topic": "/cmd_vel", "type": TWIST}],
+                           "steps": [{"wait_subscribers": "/cmd_vel"}, {"wait_publishers": "/safety_cmd"},
+                                     {"sleep": 0.3}, {"mark": "ready"}, {"sleep": 1.5},
+                                     {"publish": "/cmd_vel", "msg": {"linear": {"x": 2.0}}},
+                                     {"wait": "/safety_cmd", "timeout": 3}]}, name="driver")
+    assert '"ready"' in driver.stdout.readline()
+    ros.master.stop()  # down for good: the driver publishes 1.5 s later
+    rec = records(driver)
+    sent, stop = first(rec, "sent", "/cmd_vel"), first(rec, "recv", "/safety_cmd")
+    assert stop is not None and stop["wall"] - sent["wall"] < 0.1, ros.log(mon)
+    assert "cannot be reached" in ros.log(mon) and mon.poll() is None
+
+
+def test_a_watched_node_that_survives_a_master_restart_stays_alive_until_it_dies(ros, tmp_path):
+    victim = ros.probe_bg({"node": "victim", "anonymous": False, "steps": [{"sleep": 60}]}, name="victim")
+    mon = ros.monitor(spec(tmp_path, "entity n: /victim { rules: dead: not alive(node /victim); }\n"
+                                     "if (n.dead) then { stop; }\n"), node_rate=10)
+    listener = listen_until_stopped(ros, "/safety_cmd", TWIST, timeout=30)
+    time.sleep(0.5)
+    # rospy nodes do not re-register: the new master does not know the victim, but it lives
+    ros.master.restart(down=0.5)
+    time.sleep(1.5)
+    killed = time.time()
+    os.kill(victim.pid, signal.SIGKILL)
+    stop = first(records(listener), "recv", "/safety_cmd")
+    assert stop is not None, ros.log(mon)
+    assert stop["wall"] > killed, "no false stop while the master was down or after it came back"
+    assert stop["wall"] - killed < 0.1 + 0.1 + 0.05

@@ -1,0 +1,26 @@
+"""The monitor's /diagnostics entries, built from plain data (no ROS)."""
+from rubass.lang import check_text
+from rubass.ros import status
+
+SPEC = "entity base { rules: fast: topic /cmd_vel.linear.x > 1; }\n"
+
+
+def monitor_entry(**monitor):
+    spec = check_text(SPEC)
+    entries = status.build(spec, {"base.fast": False}, [], {}, {}, {}, monitor)
+    return entries[-1]
+
+
+def test_a_healthy_monitor_is_ok():
+    e = monitor_entry(master="connected")
+    assert e.level == status.OK and "master" not in e.message
+
+
+def test_an_unreachable_master_turns_the_monitor_warn_and_says_so():
+    e = monitor_entry(master="unreachable for 3.2 s")
+    assert e.level == status.WARN and "master unreachable for 3.2 s" in e.message
+
+
+def test_a_rejected_reload_stays_error_whatever_the_master():
+    e = monitor_entry(master="unreachable for 1.0 s", **{"last reload error": "s.rbs:1:2: error: x"})
+    assert e.level == status.ERROR
