@@ -95,14 +95,24 @@ def _scalar_fn(name: str) -> Callable[..., Any]:
 def _array_fn(name: str, read: Fn) -> Fn:
     def apply() -> Any:
         arr = read()
-        if not isinstance(arr, tuple):
+        if not isinstance(arr, (tuple, bytes)):
             return UNKNOWN
         if name == "len":
             return float(len(arr))
-        valid = [v for v in arr if type(v) is float]  # NaN readings were converted to UNKNOWN
+        if isinstance(arr, bytes):
+            return UNKNOWN if not arr else float(min(arr) if name == "min" else max(arr))
+        if arr and type(arr[0]) is float:  # a typed float array: C-speed when it holds no NaN
+            try:
+                total = sum(arr)
+            except TypeError:
+                total = math.nan
+            if total == total:  # NaN when an element is NaN (or holds both inf and -inf): filter below
+                return min(arr) if name == "min" else max(arr)
+        # numbers only, NaN (v != v) and unknown elements skipped; bool is not a number here
+        valid = [v for v in arr if (type(v) is float or type(v) is int) and v == v]
         if not valid:
             return UNKNOWN
-        return min(valid) if name == "min" else max(valid)
+        return float(min(valid) if name == "min" else max(valid))
     return apply
 
 

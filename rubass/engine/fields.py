@@ -1,7 +1,9 @@
 """Reading a field path out of a message of any type, without importing ROS.
 
 Works on deserialised rospy messages (attributes), on dicts (tests, YAML traces) and on
-anything shaped like them. Integers become floats, NaN and short arrays become UNKNOWN.
+anything shaped like them. Integers become floats, NaN and short arrays become UNKNOWN. Numeric arrays are kept as
+they come (a tuple, or bytes for uint8[]), so a huge array costs one copy, not one
+conversion per element: the array functions (min, max, len) skip NaN elements.
 """
 from __future__ import annotations
 
@@ -55,9 +57,13 @@ def convert(value: Any, path: Tuple[PathElem, ...] = ()) -> Any:
         return UNKNOWN if math.isnan(f) else f
     if isinstance(value, str):
         return value
-    if isinstance(value, (bytes, bytearray)):
-        return tuple(float(b) for b in value)
+    if isinstance(value, bytes):
+        return value  # uint8[] / char[]: kept as it is (a camera image is megabytes)
+    if isinstance(value, bytearray):
+        return bytes(value)
     if isinstance(value, (list, tuple)):
+        if value and type(value[0]) in (float, int):  # a numeric array (ROS arrays are typed):
+            return tuple(value)  # copied as it is; min/max skip its NaNs (no per-element work here)
         return tuple(convert(v, path) for v in value)
     to_sec = getattr(value, "to_sec", None)  # rospy Time / Duration
     if callable(to_sec):

@@ -22,6 +22,7 @@ class Message:
     time: float
     msg: Any = None
     received: float = 0.0  # wall-clock arrival, to measure reaction latency
+    size: int = 0  # serialised bytes, counted against the queue's byte budget
 
 
 @dataclass(frozen=True)
@@ -45,7 +46,8 @@ class EngineLoop:
     """Owns an engine; `submit` from any thread, `run` on one."""
 
     def __init__(self, engine: Engine, clock: Callable[[], float], rate: float, handler: Handler,
-                 max_queue: int = 100000, tick_hook: Optional[Callable[[float], None]] = None) -> None:
+                 max_queue: int = 100000, tick_hook: Optional[Callable[[float], None]] = None,
+                 max_bytes: int = 256 * 1024 * 1024) -> None:
         self.engine = engine
         self.clock = clock
         self.period = 1.0 / rate
@@ -53,18 +55,34 @@ class EngineLoop:
         self.tick_hook = tick_hook
         self.inbox: "queue.Queue[Any]" = queue.Queue(maxsize=max_queue)
         self.dropped = 0
+        self.max_bytes = max_bytes  # the queue holds at most this many message bytes (8 MB clouds…)
+        self.queued_bytes = 0
+        self._bytes_lock = threading.Lock()
         self._stop = threading.Event()
         self._next_tick = clock() + self.period
 
     # -- any thread ----------------------------------------------------------------------
     def submit(self, item: Any) -> bool:
-        """Queue an input; False (and counted) if the queue is full."""
+        """Queue an input; False (and counted) if the queue is full, by count or by bytes."""
+        size = item.size if isinstance(item, Message) else 0
+        if size:
+            with self._bytes_lock:
+                if self.queued_bytes + size > self.max_bytes:
+                    self.dropped += 1
+                    return False
+                self.queued_bytes += size
         try:
             self.inbox.put_nowait(item)
             return True
         except queue.Full:
             self.dropped += 1
+            self._unqueue(size)
             return False
+
+    def _unqueue(self, size: int) -> None:
+        if size:
+            with self._bytes_lock:
+                self.queued_bytes -= size
 
     def call(self, fn: Callable[[Engine], Any], timeout: float = 5.0) -> Any:
         """Run fn on the engine's thread and wait for its result (its exception is re-raised)."""
@@ -119,6 +137,7 @@ class EngineLoop:
 
     def _handle(self, item: Any) -> None:
         if isinstance(item, Message):
+            self._unqueue(item.size)
             self._emit(self.engine.on_message(item.topic, item.time, item.msg), item)
         elif isinstance(item, NodeSample):
             self._emit(self.engine.on_node_sample(item.node, item.time, item.alive, item.cpu, item.memory), item)

@@ -144,8 +144,8 @@ class Monitor:
         sampler.start()
         return sampler
 
-    def _on_message(self, topic: str, now: float, msg: Any, wall: float) -> None:
-        self.loop.submit(Message(topic, now, msg, wall))
+    def _on_message(self, topic: str, now: float, msg: Any, wall: float, size: int) -> None:
+        self.loop.submit(Message(topic, now, msg, wall, size))
 
     def _on_node(self, node: str, now: float, alive: Any, cpu: Any, memory: Any) -> None:
         self.loop.submit(NodeSample(node, now, alive, cpu, memory))

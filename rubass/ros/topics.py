@@ -19,7 +19,7 @@ from ..lang import ast
 from ..lang.model import CheckedSpec
 from .msgtypes import check_path
 
-Submit = Callable[[str, float, Any, float], None]  # (spec topic, ROS time, message or None, wall time)
+Submit = Callable[[str, float, Any, float, int], None]  # (spec topic, ROS time, message or None, wall, bytes)
 Log = Callable[[str, str], None]
 
 
@@ -79,14 +79,14 @@ class TopicWatcher:
         wall = time.time()
         state.messages += 1
         if not state.paths:
-            self.submit(state.spec_name, now, None, wall)  # age/frequency only: never deserialised
+            self.submit(state.spec_name, now, None, wall, 0)  # age/frequency only: never deserialised
             return
         header = getattr(raw, "_connection_header", None) or {}
         md5 = header.get("md5sum", "")
         if md5 != state.md5:
             self._new_type(state, header)
         if state.cls is None:
-            self.submit(state.spec_name, now, UNKNOWN, wall)
+            self.submit(state.spec_name, now, UNKNOWN, wall, 0)
             return
         try:
             msg = state.cls().deserialize(raw._buff)
@@ -95,7 +95,7 @@ class TopicWatcher:
                 state.errors.append(f"cannot deserialise a {state.type} message: {exc}")
                 self.log("error", f"topic {state.resolved}: {state.errors[-1]}")
             msg = UNKNOWN
-        self.submit(state.spec_name, now, msg, wall)
+        self.submit(state.spec_name, now, msg, wall, len(raw._buff) if msg is not UNKNOWN else 0)
 
     def _new_type(self, state: TopicState, header: Dict[str, str]) -> None:
         old = state.type

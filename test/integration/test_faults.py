@@ -1,4 +1,5 @@
-"""The monitor survives faults around it (issue #7): a master restart, ..."""
+"""The monitor keeps protecting the robot through faults around it (issue #7): a master restart,
+bad and excessive data, failing actions."""
 import os
 import signal
 import time
@@ -84,3 +85,43 @@ def test_a_watched_node_that_survives_a_master_restart_stays_alive_until_it_dies
     assert stop is not None, ros.log(mon)
     assert stop["wall"] > killed, "no false stop while the master was down or after it came back"
     assert stop["wall"] - killed < 0.1 + 0.1 + 0.05
+
+
+def flood(ros, *args, timeout=180):
+    import json
+    import subprocess
+
+    from rosharness import PY
+
+    out = subprocess.run([PY, os.path.join(os.path.dirname(__file__), "flood.py"), *map(str, args)], env=ros.env,
+                         capture_output=True, text=True, timeout=timeout)
+    assert out.returncode == 0, out.stderr
+    return json.loads(out.stdout.strip().splitlines()[-1])
+
+
+def rss_mb(proc):
+    import psutil
+
+    return psutil.Process(proc.pid).memory_info().rss / 1e6
+
+
+def test_a_burst_of_100000_messages_neither_crashes_nor_hides_the_next_violation(ros, tmp_path):
+    mon = ros.monitor(spec(tmp_path, "entity a { rules: r: topic /x.data > 1; }\nif (a.r) then { stop; }\n"))
+    time.sleep(0.5)
+    before = rss_mb(mon)
+    out = flood(ros, "burst", 100_000)
+    assert out["stop_after_s"] is not None, ros.log(mon)
+    assert out["stop_after_s"] < 1.0  # behind whatever of the burst was still queued
+    assert mon.poll() is None
+    assert rss_mb(mon) - before < 100, "the queue is bounded: 100,000 small messages cost tens of MB at most"
+
+
+def test_huge_arrays_are_read_and_the_queue_stays_within_its_byte_budget(ros, tmp_path):
+    mon = ros.monitor(spec(tmp_path, "entity a { rules: r: max(topic /cloud.data) > 5; }\n"
+                                     "if (a.r) then { stop; }\n"))
+    time.sleep(0.5)
+    before = rss_mb(mon)
+    out = flood(ros, "huge", 20, 1_000_000)  # 8 MB each, 10 per second
+    assert out["stop_after_s"] is not None and out["stop_after_s"] < 1.0, ros.log(mon)
+    assert mon.poll() is None
+    assert rss_mb(mon) - before < 300, "a few 8 MB messages in flight, not all of them"

@@ -61,6 +61,19 @@ def test_full_queue_counts_drops_instead_of_blocking():
     assert loop.dropped == 2
 
 
+def test_the_queue_holds_a_bounded_number_of_message_bytes_and_frees_them_when_handled():
+    spec = check_text("action primitive warn;\nentity a { rules: r: max(topic /x.data) > 1; }\n"
+                      "if (a.r) then { warn; }\n", os.path.join(ROOT, "x.rbs"), [LIB])
+    loop = EngineLoop(Engine(spec, 0.0), lambda: 0.0, 50.0, lambda events, cause: None, max_bytes=20_000_000)
+    cloud = Message("/x", 0.0, {"data": b"\x02" * 8_000_000}, size=8_000_000)  # an 8 MB point cloud
+    assert [loop.submit(cloud) for _ in range(3)] == [True, True, False]
+    assert loop.dropped == 1 and loop.queued_bytes == 16_000_000
+    assert loop.submit(Message("/x", 0.0, {"data": b"\x00"}, size=1))  # small ones still fit
+    loop.step(max_wait=0.01)
+    assert loop.queued_bytes == 8_000_001 and loop.engine.rule_value("a.r") is True
+    assert loop.submit(cloud)
+
+
 def test_ticks_go_on_when_the_clock_jumps_back():
     """Sim time restarting (a looping bag) must not stall ticks, and with them the heartbeat."""
     spec = check_text("action primitive warn;\nentity a { rules: r: topic /x.data > 1; }\nif (a.r) then { warn; }\n",
