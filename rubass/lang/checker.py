@@ -178,7 +178,8 @@ class _Checker:
             if path in loaded:
                 continue
             if span.line and not os.path.isfile(path):
-                why = "it is a directory" if os.path.isdir(path) else "no such file"
+                why = ("it is a directory" if os.path.isdir(path) else
+                       "not a regular file" if os.path.exists(path) else "no such file")
                 self.error(span, f"cannot import '{path}': {why}")
                 continue
             lib, diags = load_library(path, self.sources)

@@ -159,6 +159,29 @@ def load_library(path: str, sources: SourceSet) -> Tuple[Dict[str, ActionDef], L
     return parse_library(src)
 
 
+_SAFE_TAGS = {"tag:yaml.org,2002:" + t for t in
+              ("str", "int", "float", "bool", "null", "seq", "map", "binary", "timestamp", "set", "omap", "pairs",
+               "merge", "value")}
+
+
+def _foreign_tags(root: yaml.Node) -> List[yaml.Node]:
+    """Nodes whose tag a safe loader cannot build (python/object, custom '!tags'): never built,
+    but reported as an error rather than a loader traceback. Each node once: alias bombs are DAGs."""
+    seen, out, todo = set(), [], [root]
+    while todo:
+        node = todo.pop()
+        if id(node) in seen:
+            continue
+        seen.add(id(node))
+        if node.tag not in _SAFE_TAGS:
+            out.append(node)
+        if isinstance(node, yaml.MappingNode):
+            todo += [n for pair in node.value for n in pair]
+        elif isinstance(node, yaml.SequenceNode):
+            todo += list(node.value)
+    return sorted(out, key=lambda n: n.start_mark.index)
+
+
 def parse_library(src: Source) -> Tuple[Dict[str, ActionDef], List[Diagnostic]]:
     """Validate library text already read; positions point into src."""
     diags: List[Diagnostic] = []
@@ -174,6 +197,11 @@ def parse_library(src: Source) -> Tuple[Dict[str, ActionDef], List[Diagnostic]]:
     top = Span(src.name, 1, 1)
     if not isinstance(root, yaml.MappingNode):
         return {}, [Diagnostic(top, "an action library must be a mapping with a key 'actions'")]
+    foreign = _foreign_tags(root)
+    if foreign:
+        return {}, [Diagnostic(_Node(n, src.name).span, f"YAML tag '{n.tag}' is not allowed: an action library "
+                                                        f"holds plain data only (strings, numbers, booleans, "
+                                                        f"lists, mappings)") for n in foreign]
     entries = {_key(k): (k, v) for k, v in root.value}
     if "actions" not in entries:
         return {}, [Diagnostic(top, "an action library needs a top-level key 'actions'")]

@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import os
+import stat
 from typing import Optional, Tuple
 
 from .errors import Diagnostic
@@ -16,6 +17,9 @@ def read_source(path: str, what: str = "spec") -> Tuple[Optional[Source], Option
     try:
         if os.path.isdir(path):
             return None, Diagnostic(here, f"cannot read {what}: it is a directory")
+        mode = os.stat(path).st_mode
+        if not stat.S_ISREG(mode):  # a FIFO would block the reader forever, /dev/zero never ends
+            return None, Diagnostic(here, f"cannot read {what}: not a regular file")
         size = os.path.getsize(path)
         if size > MAX_BYTES:
             return None, Diagnostic(here, f"cannot read {what}: {size} bytes is over the limit of "

@@ -26,6 +26,11 @@ def test_engine_message():
     assert [r["rules"] for r in rows] == [10, 100, 1000] and all(r["mean_us"] > 0 for r in rows)
 
 
+def test_fuzz():
+    (figures,) = bench("fuzz.py", "--cases", "50", "--seed", "1")
+    assert figures["cases"] == 50 and figures["tracebacks"] == 0
+
+
 def test_for_deadline():
     (figures,) = bench("for_deadline.py", "--firings", "5")
     assert figures["firings"] == 5 and figures["max_ms"] >= figures["p50_ms"] >= 0

@@ -6,7 +6,7 @@ import time
 
 import pytest
 
-from rosharness import TWIST, first, listen_until_stopped, records, spec
+from rosharness import LIB, TWIST, first, listen_until_stopped, records, spec, wait_log
 
 pytestmark = pytest.mark.ros
 
@@ -125,3 +125,131 @@ def test_huge_arrays_are_read_and_the_queue_stays_within_its_byte_budget(ros, tm
     assert out["stop_after_s"] is not None and out["stop_after_s"] < 1.0, ros.log(mon)
     assert mon.poll() is None
     assert rss_mb(mon) - before < 300, "a few 8 MB messages in flight, not all of them"
+
+
+def test_a_stop_topic_without_subscriber_is_logged_retried_and_reaches_a_late_subscriber(ros, tmp_path):
+    mon = ros.monitor(spec(tmp_path, "entity a { rules: r: topic /x.data > 1; }\nif (a.r) then { stop; brake; }\n"))
+    rec = ros.probe({"listen": [{"topic": "/brake", "type": "std_msgs/Bool"}],  # nobody listens to /safety_cmd
+                     "advertise": [{"topic": "/x", "type": "std_msgs/Float64"}],
+                     "steps": [{"wait_subscribers": "/x"}, {"wait_publishers": "/brake"}, {"sleep": 0.3},
+                               {"publish": "/x", "msg": {"data": 5.0}}, {"wait": "/brake", "timeout": 3}]})
+    sent, brake = first(rec, "sent", "/x"), first(rec, "recv", "/brake")
+    assert brake is not None and brake["wall"] - sent["wall"] < 0.1, "the other action is untouched"
+    wait_log(mon, ros, "no node subscribes to /safety_cmd: the message reached no one")
+    # the stop is latched: a base controller that subscribes now still gets it
+    late = ros.probe({"listen": [{"topic": "/safety_cmd", "type": TWIST}], "steps": [{"mark": "up"},
+                      {"wait": "/safety_cmd", "timeout": 5}]})
+    up, stop = next(r for r in late if r["kind"] == "mark"), first(late, "recv", "/safety_cmd")
+    assert stop is not None and stop["wall"] - up["wall"] < 1.5, late  # connection + one period (1/20 s)
+
+
+def test_a_serial_board_that_vanishes_and_comes_back_gets_the_stop_it_missed(ros, tmp_path):
+    import select
+
+    def new_board():
+        master, slave = os.openpty()
+        link = tmp_path / "ttyBOARD"  # as udev's /dev/serial/by-id/… link follows the device
+        if link.is_symlink():
+            link.unlink()
+        link.symlink_to(os.ttyname(slave))
+        return master, slave
+
+    def read_until(fd, text, timeout=5.0):
+        got, end = b"", time.time() + timeout
+        while text not in got and time.time() < end:
+            if select.select([fd], [], [], 0.1)[0]:
+                got += os.read(fd, 100)
+        return got
+
+    master, slave = new_board()
+    lib = (LIB + f'  board: {{plugin: serial, port: {tmp_path / "ttyBOARD"}, baud: 115200, on_start: "S\\n", '
+           f'on_release: "R\\n"}}\n')
+    path = spec(tmp_path, "action primitive board;\nentity a { rules: r: topic /x.data > 1; }\n"
+                          "if (a.r) then { board; brake; }\n", lib=lib)
+    mon = ros.monitor(path)
+    x = lambda v: {"publish": "/x", "msg": {"data": v}}  # noqa: E731
+    ros.probe({"advertise": [{"topic": "/x", "type": "std_msgs/Float64"}],
+               "steps": [{"wait_subscribers": "/x"}, {"sleep": 0.2}, x(5.0), {"sleep": 0.3}, x(0.0), {"sleep": 0.2}]})
+    assert read_until(master, b"R\n") == b"S\nR\n"
+    os.close(master)  # unplugged
+    os.close(slave)
+    (tmp_path / "ttyBOARD").unlink()
+    time.sleep(1.0)
+    rec = ros.probe({"listen": [{"topic": "/brake", "type": "std_msgs/Bool"}],
+                     "advertise": [{"topic": "/x", "type": "std_msgs/Float64"}],
+                     "steps": [{"wait_subscribers": "/x"}, {"wait_publishers": "/brake"}, {"sleep": 0.3}, x(5.0),
+                               {"wait": "/brake", "timeout": 3}]})  # violated while the board is away: stays so
+    sent, brake = first(rec, "sent", "/x"), first(rec, "recv", "/brake")
+    assert brake is not None and brake["wall"] - sent["wall"] < 0.1, "the other action is untouched"
+    wait_log(mon, ros, "action 'board' start failed")
+    master, slave = new_board()  # plugged in again
+    back = time.time()
+    assert read_until(master, b"S\n") == b"S\n", ros.log(mon)
+    assert time.time() - back < 0.5 + 0.3, "reopened within a reopen period"
+    os.close(master)
+    os.close(slave)
+
+
+def run_bench(name, *args, timeout=600):
+    import json
+    import subprocess
+
+    from conftest import ROOT
+    from rosharness import PY
+
+    out = subprocess.run([PY, os.path.join(ROOT, "bench", name), *map(str, args)], capture_output=True, text=True,
+                         timeout=timeout)
+    assert out.returncode == 0, out.stderr
+    return json.loads(out.stdout.strip().splitlines()[-1])
+
+
+def test_a_storm_of_100_sighups_in_10_s_misses_no_stop_leaks_nothing_and_a_broken_spec_changes_nothing():
+    if not os.path.exists("/usr/bin/rosmaster"):
+        pytest.skip("ROS 1 is not installed")
+    r = run_bench("reload_storm.py", "--sighups", 100, "--seconds", 10)
+    assert r["monitor_alive"] and r["violations"] >= 250 and r["missed"] == 0, r
+    assert r["rejected"] >= 1 and r["reloads"] >= 10, r  # the broken spec was read and rejected
+    assert r["rss_growth_mb"] < 5 and r["threads_after"] <= r["threads_before"] + 2, r
+
+
+def test_the_monitor_runs_as_an_unprivileged_user_and_still_measures_and_stops(ros, tmp_path):
+    """As `nobody`: it reads the spec, subscribes, measures a root-owned node, publishes the stop."""
+    import shutil
+    import stat
+    import tempfile
+
+    import psutil
+
+    from conftest import ROOT
+    from rosharness import PY
+
+    if os.geteuid() != 0:
+        pytest.skip("not root: every other test already runs the monitor unprivileged")
+    if not shutil.which("setpriv"):
+        pytest.skip("setpriv (util-linux) is missing")
+    home = tempfile.mkdtemp(prefix="rubass-nobody-")  # pytest's tmp_path is private to root
+    try:
+        os.chmod(home, 0o755)
+        shutil.copytree(os.path.join(ROOT, "rubass"), os.path.join(home, "rubass"))
+        shutil.copy(os.path.join(ROOT, "scripts", "monitor"), home)
+        path = spec(type(tmp_path)(home), "entity n: /victim { rules: big: memory(node /victim) > 1 MB; }\n"
+                                          "if (n.big) then { stop; }\n")
+        rw = os.path.join(home, "ros")
+        os.makedirs(rw)
+        os.chmod(rw, 0o777)
+        for dirpath, dirs, files in os.walk(home):
+            for f in files:
+                os.chmod(os.path.join(dirpath, f), 0o644)
+            for d in dirs:
+                os.chmod(os.path.join(dirpath, d), os.stat(os.path.join(dirpath, d)).st_mode | stat.S_IRWXU | 0o055)
+        victim = ros.probe_bg({"node": "victim", "anonymous": False, "steps": [{"sleep": 60}]}, name="victim")
+        env = dict(ros.env, PYTHONPATH=home, ROS_HOME=rw, ROS_LOG_DIR=rw, HOME=rw)
+        mon = ros.spawn(["setpriv", "--reuid=nobody", "--regid=nogroup", "--clear-groups", "--", PY,
+                         os.path.join(home, "monitor"), "__name:=rubass", f"_spec:={path}"], "monitor-nobody", env=env)
+        ros.wait_service("/rubass/reset", mon)
+        assert psutil.Process(mon.pid).uids().real == 65534 and psutil.Process(victim.pid).uids().real == 0
+        rec = ros.probe({"listen": [{"topic": "/safety_cmd", "type": TWIST}], "steps": [{"wait": "/safety_cmd",
+                                                                                          "timeout": 10}]})
+        assert first(rec, "recv", "/safety_cmd") is not None, ros.log(mon)
+    finally:
+        shutil.rmtree(home, ignore_errors=True)

@@ -3,6 +3,11 @@ then driven through start / hold / release by its own runner thread."""
 from __future__ import annotations
 
 import importlib
+import importlib.util
+import inspect
+import os
+import sys
+import sysconfig
 from dataclasses import dataclass, field
 from typing import Any, Dict, List, Optional, Tuple
 
@@ -84,6 +89,11 @@ class CustomPlugin(ActionPlugin):
     def __init__(self, action: ActionDef) -> None:
         super().__init__(action)
         module_name, _, class_name = action.plugin.partition(":")
+        if _is_standard_library(module_name):
+            # a library must not reach code that runs commands ('subprocess:Popen', 'os:system',
+            # 'antigravity:…' opens a browser on import): plugins are the robot's own packages
+            raise ActionSetupError(f"action '{action.name}': plugin module '{module_name}' is part of Python's "
+                                   f"standard library; a custom plugin must be a class in the robot's own package")
         try:
             module = importlib.import_module(module_name)
         except Exception as exc:  # ImportError, or the module's own import-time error
@@ -92,14 +102,15 @@ class CustomPlugin(ActionPlugin):
         cls = getattr(module, class_name, None)
         if cls is None:
             raise ActionSetupError(f"action '{action.name}': module '{module_name}' has no class '{class_name}'")
+        missing = [m for m in ("start", "hold", "release") if not callable(getattr(cls, m, None))]
+        if not inspect.isclass(cls) or missing:  # checked before anything of it is called
+            raise ActionSetupError(f"action '{action.name}': {action.plugin} is not a plugin class: it needs "
+                                   f"start(ctx), hold(ctx) and release(ctx) methods")
         try:
             self.impl = cls(action.name, dict(action.params))
         except Exception as exc:
             raise ActionSetupError(f"action '{action.name}': {action.plugin}({action.name!r}, params) failed: "
                                    f"{exc.__class__.__name__}: {exc}") from None
-        missing = [m for m in ("start", "hold", "release") if not callable(getattr(self.impl, m, None))]
-        if missing:
-            raise ActionSetupError(f"action '{action.name}': {action.plugin} lacks {', '.join(missing)}()")
         self.per_behaviour = bool(getattr(self.impl, "per_behaviour", False))
         self.period = getattr(self.impl, "period", None)
 
@@ -140,6 +151,24 @@ def make_plugin(action: ActionDef) -> ActionPlugin:
         return ServicePlugin(action)
     from .log import LogPlugin
     return LogPlugin(action)
+
+
+def _is_standard_library(module_name: str) -> bool:
+    """Whether the top-level package is Python's own (found without importing it)."""
+    top = module_name.split(".")[0]
+    names = getattr(sys, "stdlib_module_names", None)  # Python 3.10+
+    if names is not None:
+        return top in names
+    if top in sys.builtin_module_names:
+        return True
+    try:
+        spec = importlib.util.find_spec(top)
+    except (ImportError, ValueError):
+        return False
+    origin = getattr(spec, "origin", None) or ""
+    stdlib = os.path.realpath(sysconfig.get_paths()["stdlib"])
+    path = os.path.realpath(origin)
+    return path.startswith(stdlib + os.sep) and "-packages" not in path
 
 
 def describe(ctx: Context) -> str:

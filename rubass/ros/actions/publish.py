@@ -61,6 +61,12 @@ class PublishPlugin(ActionPlugin):
     def start(self, ctx: Context) -> None:
         assert self.pub is not None
         self.pub.publish(self.msg)
+        if self.pub.get_num_connections() == 0:
+            # not an error rospy would report: the message just went nowhere. A failure, so it is
+            # logged, counted in /diagnostics and retried (0.05 s, 0.1 s, … then every 1 s); the
+            # periodic publication also reaches a subscriber that connects later.
+            raise IOError(f"no node subscribes to {self.params['topic']}: the message reached no one; "
+                          f"it is sent again as soon as one does")
 
     def periodic(self) -> None:
         if self.active and self.pub is not None:
