@@ -10,8 +10,8 @@ __all__ = ["PEER", "PY", "LIB", "PrivateMaster", "stop_processes", "spec_text", 
 
 PEER = os.path.join(os.path.dirname(os.path.abspath(__file__)), "_peer.py")
 PY = "/usr/bin/python3"
-# one stop per start: the action's periodic re-publication (every 100 s) never falls in a run
-LIB = "actions:\n  stop: {plugin: publish, topic: /bench/stop, type: std_msgs/Header, message: {}, rate: 0.01 Hz}\n"
+# one stop per start: the action's periodic re-publication (every 10,000 s) never falls in a run, soak included
+LIB = "actions:\n  stop: {plugin: publish, topic: /bench/stop, type: std_msgs/Header, message: {}, rate: 0.0001 Hz}\n"
 
 
 def spec_text(load_topics, load_rules, hit="topic /bench/cmd.point.x > 1"):

@@ -10,6 +10,8 @@ Parameters (private)
     ~diagnostics_rate (Hz, 1)     /diagnostics publications
     ~master_rate (Hz, default 4)  checks that the master still knows the monitor (re-registers
                                   after a master restart: docs/monitor.md)
+    ~overload_actions (list)      actions to run while the engine's queue drops messages (fail safe)
+    ~queue_size (default 100000)  messages the engine's queue holds (and 256 MiB of message bytes)
 Subscribes
     every topic the spec names, whatever its type (rospy.AnyMsg, tcp_nodelay)
 Publishes
@@ -48,6 +50,7 @@ from .dispatch import Dispatcher
 from .master_watch import MasterWatch
 from .nodes import NodeSampler
 from .outputs import Outputs
+from .overload import OverloadGuard
 from .params import MonitorConfig, ParamError, read_config
 from .topics import TopicWatcher
 
@@ -84,9 +87,16 @@ class Monitor:
             spec = load_spec(self.config.spec, self.config.actions)
         except SpecError as exc:
             raise StartupError(exc.render()) from None
+        self._check_overload_actions(spec)
         for w in spec.warnings:
             rospy.logwarn("rubass: %s", w.render(spec.sources))
         return spec, self._runners(spec, {})
+
+    def _check_overload_actions(self, spec: CheckedSpec) -> None:
+        missing = [a for a in self.config.overload_actions if a not in spec.actions]
+        if missing:
+            raise StartupError(f"{spec.path}: ~overload_actions names {', '.join(missing)}, which the spec does not "
+                               f"declare (add 'action primitive {', '.join(missing)};')")
 
     def _runners(self, spec: CheckedSpec, keep: Dict[str, ActionRunner]) -> Dict[str, ActionRunner]:
         """Runners for the spec's actions, reusing those whose definition did not change."""
@@ -113,11 +123,12 @@ class Monitor:
         self.runners = runners
         self.outputs = Outputs()
         self.dispatcher = Dispatcher(runners, self.outputs.event, _ros_now)
+        self.overload = OverloadGuard(self.config.overload_actions, 1.0, _log, self.outputs.event)
         now = _ros_now()
         engine = Engine(spec, now)
         self.loop = EngineLoop(engine, _ros_now, self.config.rate,
                                lambda events, cause: self.dispatcher.handle(self.loop.engine, events, cause),
-                               tick_hook=self.outputs.beat)
+                               max_queue=self.config.queue_size, tick_hook=self._tick)
         for runner in runners.values():
             runner.start_thread()
         self.dispatcher.handle(engine, engine.evaluate_all(now), "reload")
@@ -137,6 +148,12 @@ class Monitor:
         self.master_watch.start()
         rospy.loginfo("rubass: enforcing %s (%d rules, %d behaviours, %d topics, %d nodes)", spec.path,
                       len(spec.rules), len(spec.behaviours), len(spec.topics), len(spec.nodes))
+
+    def _tick(self, now: float) -> None:
+        """On the engine's thread at each tick: the heartbeat, then the overload check."""
+        self.outputs.beat(now)
+        self.overload.check(self.loop.dropped, now, self.dispatcher.runners,
+                            lambda name: self.loop.engine.spec.actions[name].latch)
 
     def _sampler(self, spec: CheckedSpec) -> NodeSampler:
         nodes = [(n, rospy.resolve_name(n)) for n in sorted(spec.nodes)]
@@ -193,6 +210,7 @@ class Monitor:
             t0 = time.monotonic()
             try:
                 spec = self._load_stable()
+                self._check_overload_actions(spec)
                 t_check = time.monotonic()
                 if spec.behaviours == [] and self.spec.behaviours:
                     raise StartupError(f"{spec.path}: the new spec has no behaviours; refusing to drop every "
@@ -265,6 +283,7 @@ class Monitor:
             self.dispatcher.handle(engine, events, "reset")
             n = len(self.dispatcher.orphans)
             self.dispatcher.release_orphans(now)
+            n += self.overload.reset(now, self.dispatcher.runners)
             return sum(e.kind == "release" for e in events) + n
 
         released = self.loop.call(do)
@@ -289,6 +308,7 @@ class Monitor:
             "spec": self.spec.path, "reloads": self.reloads, "rejected reloads": self.rejected,
             "coalesced reload requests": self.coalesced,
             "last reload error": self.last_reload_error, "dropped messages": self.loop.dropped,
+            "overloaded": "yes: running " + ", ".join(self.overload.actions) if self.overload.active else "no",
             "action failures": failures,
             "master": self.master_watch.state, "master re-registrations": self.master_watch.reregistrations,
             "reaction latency p50 ms": f"{lat[len(lat) // 2] * 1000:.3f}" if lat else "n/a",
@@ -311,6 +331,8 @@ class Monitor:
                 b = engine.spec.behaviours[index - 1]
                 if not b.latched:
                     self.dispatcher.release(b, keys[index], now)
+            if not any(engine.spec.actions[a].latch for a in self.overload.actions):
+                self.overload.release(now, self.dispatcher.runners, "the monitor stops")
 
         rospy.loginfo("rubass: stopping: releasing non-latched actions")
         try:

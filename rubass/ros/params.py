@@ -23,6 +23,8 @@ class MonitorConfig:
     node_rate: float = 10.0  # node samples per second
     diagnostics_rate: float = 1.0
     master_rate: float = 4.0  # checks per second that the master still knows the monitor
+    overload_actions: List[str] = field(default_factory=list)  # run while messages are dropped
+    queue_size: int = 100000  # messages the engine's queue holds
 
 
 def _rate(get: Getter, name: str, default: float, lo: float, hi: float) -> float:
@@ -38,6 +40,16 @@ def _rate(get: Getter, name: str, default: float, lo: float, hi: float) -> float
     return q[0]
 
 
+def _names(get: Getter, name: str, what: str) -> List[str]:
+    """A list param, also accepted as one string separated by commas or spaces."""
+    value = get(name, [])
+    if isinstance(value, str):
+        value = [a for a in value.replace(",", " ").split() if a]
+    if not isinstance(value, list) or not all(isinstance(a, str) and a for a in value):
+        raise ParamError(f"~{name} must be a list of {what}, got {value!r}")
+    return value
+
+
 def read_config(get: Getter) -> MonitorConfig:
     """The configuration from a param getter (rospy.get_param with '~' names, or a dict's get)."""
     spec = get("spec", _MISSING)
@@ -46,11 +58,11 @@ def read_config(get: Getter) -> MonitorConfig:
                          "'rosrun rubass monitor _spec:=/path/to/safety.rbs'")
     if not isinstance(spec, str) or not spec.strip():
         raise ParamError(f"~spec must be the path of a .rbs file, got {spec!r}")
-    actions = get("actions", [])
-    if isinstance(actions, str):
-        actions = [a for a in actions.replace(",", " ").split() if a]
-    if not isinstance(actions, list) or not all(isinstance(a, str) and a for a in actions):
-        raise ParamError(f"~actions must be a list of action library paths, got {actions!r}")
+    actions = _names(get, "actions", "action library paths")
+    overload = _names(get, "overload_actions", "action names")
+    queue_size = get("queue_size", 100000)
+    if not isinstance(queue_size, int) or isinstance(queue_size, bool) or not 10 <= queue_size <= 10_000_000:
+        raise ParamError(f"~queue_size must be a whole number of messages from 10 to 10000000, got {queue_size!r}")
     return MonitorConfig(
         spec=os.path.expanduser(spec),
         actions=[os.path.expanduser(a) for a in actions],
@@ -58,4 +70,6 @@ def read_config(get: Getter) -> MonitorConfig:
         node_rate=_rate(get, "node_rate", 10.0, 0.1, 100.0),
         diagnostics_rate=_rate(get, "diagnostics_rate", 1.0, 0.1, 10.0),
         master_rate=_rate(get, "master_rate", 4.0, 0.1, 100.0),
+        overload_actions=overload,
+        queue_size=queue_size,
     )

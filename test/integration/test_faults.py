@@ -253,3 +253,33 @@ def test_the_monitor_runs_as_an_unprivileged_user_and_still_measures_and_stops(r
         assert first(rec, "recv", "/safety_cmd") is not None, ros.log(mon)
     finally:
         shutil.rmtree(home, ignore_errors=True)
+
+
+def test_when_messages_are_dropped_the_overload_actions_run_until_calm(ros, tmp_path):
+    filler = "".join(f"  f{i}: (topic /x.data > {i + 10}) for 1 s;\n" for i in range(400))  # ~1 ms a message
+    mon = ros.monitor(spec(tmp_path, "entity a { rules:\n  r: topic /x.data > 1;\n" + filler + "}\n"
+                                     "if (a.r) then { stop; }\n"), queue_size=10, overload_actions="brake")
+    brake = listen_until_stopped(ros, "/brake", "std_msgs/Bool", name="brake", timeout=30)
+    out = flood(ros, "burst", 20_000)
+    assert out["stop_after_s"] is not None, ros.log(mon)
+    rec = records(brake)
+    assert first(rec, "recv", "/brake") is not None, ros.log(mon)
+    wait_log(mon, ros, "overloaded: ")
+    wait_log(mon, ros, "overload over (no message dropped for 1 s): releasing brake")
+    assert mon.poll() is None
+
+
+def test_overload_actions_the_spec_does_not_declare_are_refused_at_start(ros, tmp_path):
+    mon = ros.monitor(spec(tmp_path, FAST), wait=False, overload_actions="halt")
+    assert mon.wait(20) == 1
+    assert "~overload_actions names halt, which the spec does not declare" in ros.log(mon)
+
+
+def test_a_60_s_soak_at_1000_messages_per_s_misses_nothing_and_memory_stays_flat():
+    """The CI cut of bench/soak.py (10 minutes there)."""
+    if not os.path.exists("/usr/bin/rosmaster"):
+        pytest.skip("ROS 1 is not installed")
+    r = run_bench("soak.py", "--seconds", 60)
+    assert r["monitor_alive"] and r["violations"] >= 550 and r["missed"] == 0, r
+    assert r["dropped"] == 0 and r["messages"] >= 50_000, r
+    assert r["rss_growth_mb"] < 5, r

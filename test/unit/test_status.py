@@ -24,3 +24,8 @@ def test_an_unreachable_master_turns_the_monitor_warn_and_says_so():
 def test_a_rejected_reload_stays_error_whatever_the_master():
     e = monitor_entry(master="unreachable for 1.0 s", **{"last reload error": "s.rbs:1:2: error: x"})
     assert e.level == status.ERROR
+
+
+def test_an_overloaded_monitor_is_error_and_names_the_fail_safe_actions():
+    e = monitor_entry(master="connected", overloaded="yes: running stop")
+    assert e.level == status.ERROR and "OVERLOADED, dropping messages: running stop" in e.message

@@ -1,0 +1,66 @@
+"""Failing safe when the monitor cannot keep up.
+
+A monitor whose engine queue is full drops messages, and a dropped message may be the one
+that shows a violation. With `~overload_actions` set (e.g. `[stop]`), the monitor runs those
+actions as soon as a message is dropped, and releases them once no message has been dropped
+for `calm` seconds (a latched action stays until `~reset`). Checked on every engine tick.
+"""
+from __future__ import annotations
+
+from typing import Any, Callable, Dict, Sequence
+
+from .actions.base import Context
+
+KEY = ("rubass-overload", 0)  # the runners' identity for this pseudo-behaviour
+Log = Callable[[str, str], None]
+Report = Callable[[Dict[str, Any]], None]
+
+
+class OverloadGuard:
+    def __init__(self, actions: Sequence[str], calm: float, log: Log, report: Report) -> None:
+        self.actions, self.calm, self.log, self.report = list(actions), calm, log, report
+        self.active = False
+        self.episodes = 0
+        self._seen = 0  # drops already accounted for
+        self._last_drop = 0.0
+
+    def check(self, dropped: int, now: float, runners: Dict[str, Any], latched: Callable[[str], bool]) -> None:
+        """On the engine's thread, at each tick: start on new drops, hold, release when calm."""
+        if dropped > self._seen:
+            new, self._seen, self._last_drop = dropped - self._seen, dropped, now
+            if not self.active and self.actions:
+                self.active = True
+                self.episodes += 1
+                self.log("error", f"overloaded: {new} messages dropped (the engine's queue is full): running the "
+                                  f"fail-safe actions {', '.join(self.actions)} (~overload_actions)")
+                self._send("start", now, runners)
+                return
+        if not self.active:
+            return
+        if now - self._last_drop >= self.calm and not any(latched(a) for a in self.actions):
+            self.release(now, runners, f"no message dropped for {self.calm:g} s")
+        else:
+            self._send("hold", now, runners)
+
+    def release(self, now: float, runners: Dict[str, Any], why: str) -> None:
+        if self.active:
+            self.active = False
+            self.log("warn", f"overload over ({why}): releasing {', '.join(self.actions)}")
+            self._send("release", now, runners)
+
+    def reset(self, now: float, runners: Dict[str, Any]) -> bool:
+        """~reset: release latched fail-safe actions once calm; whether it did."""
+        if self.active and now - self._last_drop >= self.calm:
+            self.release(now, runners, "reset")
+            return True
+        return False
+
+    def _send(self, kind: str, now: float, runners: Dict[str, Any]) -> None:
+        for name in self.actions:
+            runner = runners.get(name)
+            if runner is not None:
+                runner.submit(kind, Context(0, 0, ("monitor.overloaded",), (), now, KEY))
+        if kind != "hold":
+            self.report({"time": now, "event": kind, "behaviour": 0, "line": 0, "actions": self.actions,
+                         "rules": ["monitor.overloaded"], "cause": "overload", "latency_ms": None})
+
