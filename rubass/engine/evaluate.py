@@ -107,7 +107,7 @@ def _array_fn(name: str, read: Fn) -> Fn:
             except TypeError:
                 total = math.nan
             if total == total:  # NaN when an element is NaN (or holds both inf and -inf): filter below
-                return min(arr) if name == "min" else max(arr)
+                return float(min(arr) if name == "min" else max(arr))
         # numbers only, NaN (v != v) and unknown elements skipped; bool is not a number here
         valid = [v for v in arr if (type(v) is float or type(v) is int) and v == v]
         if not valid:

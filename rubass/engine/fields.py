@@ -1,9 +1,9 @@
 """Reading a field path out of a message of any type, without importing ROS.
 
 Works on deserialised rospy messages (attributes), on dicts (tests, YAML traces) and on
-anything shaped like them. Integers become floats, NaN and short arrays become UNKNOWN. Numeric arrays are kept as
-they come (a tuple, or bytes for uint8[]), so a huge array costs one copy, not one
-conversion per element: the array functions (min, max, len) skip NaN elements.
+anything shaped like them. Integers become floats, NaN and short arrays become UNKNOWN.
+Numeric arrays are kept as they come (a tuple, or bytes for uint8[]), so a huge array costs
+one copy, not one conversion per element; the array functions (min, max, len) skip NaN.
 """
 from __future__ import annotations
 

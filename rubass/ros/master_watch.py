@@ -79,7 +79,6 @@ class MasterWatch:
         self.period, self.timeout, self.log = period, timeout, log
         self.state = "connected"
         self.reregistrations = 0
-        self.last: Optional[Registered] = None
         self.down_since: Optional[float] = None  # monotonic time of the first failed poll
         self._stop = threading.Event()
         self._thread: Optional[threading.Thread] = None
@@ -125,7 +124,6 @@ class MasterWatch:
             return "foreign"
         reg = register_all(master, self.caller_id, self.node_uri)
         self.reregistrations += 1
-        self.last = reg
         self.state = "connected"
         self.log("warn", f"the master at {self.master_uri} did not know this node (it restarted): registered "
                          f"{reg.publishers} publishers, {reg.subscribers} subscribers and {reg.services} services "

@@ -214,6 +214,7 @@ def test_a_storm_of_100_sighups_in_10_s_misses_no_stop_leaks_nothing_and_a_broke
 
 def test_the_monitor_runs_as_an_unprivileged_user_and_still_measures_and_stops(ros, tmp_path):
     """As `nobody`: it reads the spec, subscribes, measures a root-owned node, publishes the stop."""
+    import pathlib
     import shutil
     import stat
     import tempfile
@@ -232,8 +233,8 @@ def test_the_monitor_runs_as_an_unprivileged_user_and_still_measures_and_stops(r
         os.chmod(home, 0o755)
         shutil.copytree(os.path.join(ROOT, "rubass"), os.path.join(home, "rubass"))
         shutil.copy(os.path.join(ROOT, "scripts", "monitor"), home)
-        path = spec(type(tmp_path)(home), "entity n: /victim { rules: big: memory(node /victim) > 1 MB; }\n"
-                                          "if (n.big) then { stop; }\n")
+        path = spec(pathlib.Path(home), "entity n: /victim { rules: big: memory(node /victim) > 1 MB; }\n"
+                                        "if (n.big) then { stop; }\n")
         rw = os.path.join(home, "ros")
         os.makedirs(rw)
         os.chmod(rw, 0o777)
