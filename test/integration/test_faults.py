@@ -284,3 +284,20 @@ def test_a_60_s_soak_at_1000_messages_per_s_misses_nothing_and_memory_stays_flat
     assert r["monitor_alive"] and r["violations"] >= 550 and r["missed"] == 0, r
     assert r["dropped"] == 0 and r["messages"] >= 50_000, r
     assert r["rss_growth_mb"] < 5, r
+
+
+def test_a_topic_republished_with_another_type_is_unknown_logged_and_the_monitor_goes_on(ros, tmp_path):
+    mon = ros.monitor(spec(tmp_path, "entity a { rules: r: topic /x.data > 1; }\nif (a.r) then { brake; }\n"))
+    brake = lambda: {"listen": [{"topic": "/brake", "type": "std_msgs/Bool"}]}  # noqa: E731
+    rec = ros.probe(dict(brake(), advertise=[{"topic": "/x", "type": "std_msgs/Float64"}],
+                         steps=[{"wait_subscribers": "/x"}, {"wait_publishers": "/brake"}, {"sleep": 0.3},
+                                {"publish": "/x", "msg": {"data": 5.0}}, {"wait": "/brake", "timeout": 3}]))
+    assert first(rec, "recv", "/brake") is not None
+    # the same topic, now a string: the rule is unknown, so the (non-latched) brake is released
+    rec = ros.probe(dict(brake(), advertise=[{"topic": "/x", "type": "std_msgs/String"}],
+                         steps=[{"wait_subscribers": "/x"}, {"sleep": 0.3}, {"publish": "/x", "msg": {"data": "fast"}},
+                                {"sleep": 0.3}, {"mark": "after"}, {"sleep": 0.5}]))
+    after = next(r["wall"] for r in rec if r["kind"] == "mark")
+    assert not [r for r in rec if r["kind"] == "recv" and r["wall"] > after], "released: unknown never fires"
+    wait_log(mon, ros, "topic /x changed type from std_msgs/Float64 to std_msgs/String")
+    assert mon.poll() is None
