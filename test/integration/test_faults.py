@@ -301,3 +301,27 @@ def test_a_topic_republished_with_another_type_is_unknown_logged_and_the_monitor
     assert not [r for r in rec if r["kind"] == "recv" and r["wall"] > after], "released: unknown never fires"
     wait_log(mon, ros, "topic /x changed type from std_msgs/Float64 to std_msgs/String")
     assert mon.poll() is None
+
+
+WRONG_MD5 = """
+import time, genpy.dynamic, rospy
+rospy.init_node("forked", anonymous=True, disable_signals=True)
+cls = genpy.dynamic.generate_dynamic("std_msgs/Float64", "float32 data\\n")["std_msgs/Float64"]
+pub = rospy.Publisher("/x", cls, queue_size=10, tcp_nodelay=True)
+while pub.get_num_connections() < 1:
+    time.sleep(0.05)
+time.sleep(0.3)
+pub.publish(cls(data=5.0))
+time.sleep(3)
+"""
+
+
+def test_a_publisher_with_a_wrong_md5_is_read_by_its_own_definition(ros, tmp_path):
+    """A node built against another std_msgs/Float64 (float32 data): other md5, same name."""
+    from rosharness import PY
+
+    mon = ros.monitor(spec(tmp_path, "entity a { rules: r: topic /x.data > 1; }\nif (a.r) then { stop; }\n"))
+    listener = listen_until_stopped(ros, "/safety_cmd", TWIST, timeout=10)
+    forked = ros.spawn([PY, "-c", WRONG_MD5], "forked")
+    assert first(records(listener), "recv", "/safety_cmd") is not None, ros.log(mon) + ros.log(forked)
+    assert "Traceback" not in ros.log(mon) and mon.poll() is None
