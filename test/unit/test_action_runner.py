@@ -113,3 +113,18 @@ def test_queue_stays_bounded_when_a_stuck_plugin_meets_a_flapping_condition():
         r.submit("release", Context(1, 0))
     assert len(r._queue) <= runner_mod.MAX_PENDING + 1
     assert r.stats.extra["dropped pairs"] > 0
+
+
+def test_periodic_work_goes_on_while_a_failing_start_is_retried_and_a_release_cuts_the_wait():
+    p = Fake(fail_starts=100)
+    p.period = 0.02
+    ticks = []
+    p.periodic = lambda: ticks.append(time.monotonic())
+    r, logs = runner(p)
+    r.submit("start", Context(1, 0))
+    time.sleep(1.5)  # the retries back off to 1 s apart by now
+    assert len([t for t in ticks if t > ticks[0] + 1.0]) > 10, "a publish keeps its rate while start fails"
+    t0 = time.monotonic()
+    r.submit("release", Context(1, 0))
+    assert p.done.wait(2.0) and time.monotonic() - t0 < 0.2, "the release did not wait out the 1 s backoff"
+    r.stop()

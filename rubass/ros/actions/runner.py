@@ -28,6 +28,7 @@ class ActionRunner:
         self._hold_pending = False
         self._active: Set[Any] = set()  # identities of the behaviours this action is active for
         self._stop = False
+        self._next_periodic = float("inf")
         self._last_log = 0.0
         self._thread: Optional[threading.Thread] = None
 
@@ -93,12 +94,12 @@ class ActionRunner:
 
     # -- the runner's thread -------------------------------------------------------------
     def _run(self) -> None:
-        period = self.plugin.period
-        next_periodic = time.monotonic() + period if period else float("inf")
+        if self.plugin.period:
+            self._next_periodic = time.monotonic() + self.plugin.period
         while True:
             with self._cond:
                 while not self._queue and not self._stop:
-                    wait = next_periodic - time.monotonic()
+                    wait = self._next_periodic - time.monotonic()
                     if wait <= 0:
                         break
                     self._cond.wait(min(wait, 1.0))
@@ -109,9 +110,13 @@ class ActionRunner:
                     self._hold_pending = False
             if item is not None:
                 self._do(*item)
-            if period and time.monotonic() >= next_periodic:
-                self._guard("periodic", self.plugin.periodic)
-                next_periodic = max(next_periodic + period, time.monotonic())
+            self._periodic_if_due()
+
+    def _periodic_if_due(self) -> None:
+        period = self.plugin.period
+        if period and time.monotonic() >= self._next_periodic:
+            self._guard("periodic", self.plugin.periodic)
+            self._next_periodic = max(self._next_periodic + period, time.monotonic())
 
     def _superseded(self, kind: str, ctx: Context) -> bool:
         with self._cond:
@@ -126,12 +131,17 @@ class ActionRunner:
         while attempt == 0 or not self._superseded(kind, ctx):  # retries only, never the first try
             if self._guard(kind, lambda: call(ctx)) or kind == "hold":
                 return
-            delay = BACKOFF[min(attempt, len(BACKOFF) - 1)]
+            retry_at = time.monotonic() + BACKOFF[min(attempt, len(BACKOFF) - 1)]
             attempt += 1
-            with self._cond:
-                if self._stop and kind != "release":
-                    return
-                self._cond.wait(delay)
+            while True:  # the periodic work goes on meanwhile (a publish keeps its rate, a port reopens)
+                with self._cond:
+                    if self._stop and kind != "release":
+                        return
+                    now = time.monotonic()
+                    if now >= retry_at or self._queue:  # a new phase: is this one superseded?
+                        break
+                    self._cond.wait(min(retry_at, self._next_periodic) - now)
+                self._periodic_if_due()
             if self._stop and attempt > 3:
                 return  # at shutdown a release is tried a few times, not forever
 
