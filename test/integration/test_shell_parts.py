@@ -83,33 +83,17 @@ def test_topics_read_only_by_age_are_never_deserialised():
     assert len(got) == 1 and got[0][0] == "/blob" and got[0][2] is None and state.cls is None
 
 
-def test_a_topic_that_changes_type_is_reported_and_its_fields_rechecked():
-    import io
-
+def _watch(topic="/x", body="entity a { rules: r: topic /x.data > 1; }\n"):
+    """A TopicWatcher on one topic of a spec, fed by hand: (watcher, state, submitted, logs)."""
     import rospy
-    from std_msgs.msg import Float64, String
 
     from rubass.ros.topics import TopicState, TopicWatcher
 
     rospy.rostime.set_rostime_initialized(True)
-    spec = check_text("entity a { rules: r: topic /x.data > 1; }\n", "/tmp/x.rbs")
+    spec = check_text(body, "/tmp/x.rbs")
     got, logs = [], []
     watcher = TopicWatcher(lambda *a: got.append(a), lambda level, text: logs.append(text))
-    state = TopicState("/x", "/x", spec.field_readers()["/x"])
-
-    def raw(msg):
-        buf = io.BytesIO()
-        msg.serialize(buf)
-        r = type("Raw", (), {})()
-        r._buff = buf.getvalue()
-        r._connection_header = {"type": msg._type, "md5sum": msg._md5sum, "message_definition": msg._full_text}
-        return r
-
-    watcher._callback(raw(Float64(5.0)), state)
-    watcher._callback(raw(String("five")), state)
-    assert got[0][2].data == 5.0 and got[1][2].data == "five"
-    assert "topic /x changed type from std_msgs/Float64 to std_msgs/String" in logs
-    assert state.type == "std_msgs/String" and "changed type from std_msgs/Float64 to std_msgs/String" in state.errors
+    return watcher, TopicState(topic, topic, spec.field_readers()[topic]), got, logs
 
 
 def _raw(buff, type_name, md5, definition):
@@ -118,48 +102,48 @@ def _raw(buff, type_name, md5, definition):
     return r
 
 
-def test_a_publisher_with_another_definition_under_a_known_name_is_read_by_its_own_definition():
+def _raw_of(msg):
+    """What rospy.AnyMsg hands the callback for msg: its bytes and its connection header."""
     import io
 
+    buf = io.BytesIO()
+    msg.serialize(buf)
+    return _raw(buf.getvalue(), msg._type, msg._md5sum, msg._full_text)
+
+
+def test_a_topic_that_changes_type_is_reported_and_its_fields_rechecked():
+    from std_msgs.msg import Float64, String
+
+    watcher, state, got, logs = _watch()
+    watcher._callback(_raw_of(Float64(5.0)), state)
+    watcher._callback(_raw_of(String("five")), state)
+    assert got[0][2].data == 5.0 and got[1][2].data == "five"
+    assert "topic /x changed type from std_msgs/Float64 to std_msgs/String" in logs
+    assert state.type == "std_msgs/String" and "changed type from std_msgs/Float64 to std_msgs/String" in state.errors
+
+
+def test_a_publisher_with_another_definition_under_a_known_name_is_read_by_its_own_definition():
     import genpy.dynamic
-    import rospy
 
-    from rubass.ros.topics import TopicState, TopicWatcher
-
-    rospy.rostime.set_rostime_initialized(True)
-    spec = check_text("entity a { rules: r: topic /x.data > 1; }\n", "/tmp/x.rbs")
-    got, logs = [], []
-    watcher = TopicWatcher(lambda *a: got.append(a), lambda level, text: logs.append(text))
-    state = TopicState("/x", "/x", spec.field_readers()["/x"])
+    watcher, state, got, logs = _watch()
     # an old or forked std_msgs/Float64 whose data is a float32: another md5 than the installed one
     fake = genpy.dynamic.generate_dynamic("std_msgs/Float64", "float32 data\n")["std_msgs/Float64"]
-    buf = io.BytesIO()
-    fake(data=2.5).serialize(buf)
-    watcher._callback(_raw(buf.getvalue(), "std_msgs/Float64", fake._md5sum, "float32 data\n"), state)
+    watcher._callback(_raw_of(fake(data=2.5)), state)
     assert got[-1][2].data == 2.5 and state.errors == [], logs
     # the same name with a definition that lacks the field: unknown, and said why
     other = genpy.dynamic.generate_dynamic("std_msgs/Float64", "int32 value\n")["std_msgs/Float64"]
-    buf = io.BytesIO()
-    other(value=7).serialize(buf)
-    watcher._callback(_raw(buf.getvalue(), "std_msgs/Float64", other._md5sum, "int32 value\n"), state)
+    watcher._callback(_raw_of(other(value=7)), state)
     assert any("reads /x.data, but in std_msgs/Float64: std_msgs/Float64 has no field 'data'" in e
                for e in state.errors), state.errors
 
 
 def test_a_payload_that_does_not_match_its_type_is_unknown_and_logged_once():
-    import rospy
     from std_msgs.msg import Float64
 
     from rubass.engine import UNKNOWN
-    from rubass.ros.topics import TopicState, TopicWatcher
 
-    rospy.rostime.set_rostime_initialized(True)
-    spec = check_text("entity a { rules: r: topic /x.data > 1; }\n", "/tmp/x.rbs")
-    got, logs = [], []
-    watcher = TopicWatcher(lambda *a: got.append(a), lambda level, text: logs.append(text))
-    state = TopicState("/x", "/x", spec.field_readers()["/x"])
+    watcher, state, got, logs = _watch()
     for _ in range(1000):  # 3 bytes where a float64 needs 8
         watcher._callback(_raw(b"\x01\x02\x03", "std_msgs/Float64", Float64._md5sum, Float64._full_text), state)
     assert all(g[2] is UNKNOWN for g in got) and len(got) == 1000
     assert len([t for t in logs if "cannot deserialise" in t]) == 1, "logged once, not once per message"
-
