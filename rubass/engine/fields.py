@@ -10,7 +10,7 @@ from __future__ import annotations
 import math
 from typing import Any, Tuple
 
-from ..lang.ast import PathElem
+from ..lang.ast import PathElem, path_suffix
 from .values import UNKNOWN
 
 
@@ -19,7 +19,7 @@ class FieldError(Exception):
 
 
 def path_text(path: Tuple[PathElem, ...]) -> str:
-    return "".join(f"[{p}]" if isinstance(p, int) else f".{p}" for p in path).lstrip(".")
+    return path_suffix(path).lstrip(".")
 
 
 def extract(msg: Any, path: Tuple[PathElem, ...]) -> Any:

@@ -50,6 +50,11 @@ class Name:
 PathElem = Union[str, int]
 
 
+def path_suffix(path: Tuple[PathElem, ...]) -> str:
+    """A field path as written after a topic name: `.pose.position.x`, `.ranges[0]`, `[0]`."""
+    return "".join(f"[{p}]" if isinstance(p, int) else f".{p}" for p in path)
+
+
 @dataclass(frozen=True)
 class TopicRef:
     """`topic /odom.pose.pose.position.x` or `topic /scan.ranges[0]` or bare `topic /t`."""
@@ -60,7 +65,7 @@ class TopicRef:
 
     @property
     def path_text(self) -> str:
-        return "".join(f"[{p}]" if isinstance(p, int) else f".{p}" for p in self.path)
+        return path_suffix(self.path)
 
 
 @dataclass(frozen=True)

@@ -115,8 +115,7 @@ class TopicWatcher:
         for path, owners in state.paths.items():
             problem = check_path(state.cls, path) if state.cls is not None else None
             if problem:
-                field_text = "".join(f"[{p}]" if isinstance(p, int) else f".{p}" for p in path)
-                out.append(f"{' and '.join(owners)} reads {state.spec_name}{field_text}, but in {state.type}: "
+                out.append(f"{' and '.join(owners)} reads {state.spec_name}{ast.path_suffix(path)}, but in {state.type}: "
                            f"{problem}; its value stays unknown")
         return out
 
