@@ -308,7 +308,7 @@ class Monitor:
             "spec": self.spec.path, "reloads": self.reloads, "rejected reloads": self.rejected,
             "coalesced reload requests": self.coalesced,
             "last reload error": self.last_reload_error, "dropped messages": self.loop.dropped,
-            "overloaded": "yes: running " + ", ".join(self.overload.actions) if self.overload.active else "no",
+            "overloaded": "running " + ", ".join(self.overload.actions) if self.overload.active else "no",
             "action failures": failures,
             "master": self.master_watch.state, "master re-registrations": self.master_watch.reregistrations,
             "reaction latency p50 ms": f"{lat[len(lat) // 2] * 1000:.3f}" if lat else "n/a",

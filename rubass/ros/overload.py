@@ -20,7 +20,6 @@ class OverloadGuard:
     def __init__(self, actions: Sequence[str], calm: float, log: Log, report: Report) -> None:
         self.actions, self.calm, self.log, self.report = list(actions), calm, log, report
         self.active = False
-        self.episodes = 0
         self._seen = 0  # drops already accounted for
         self._last_drop = 0.0
 
@@ -30,7 +29,6 @@ class OverloadGuard:
             new, self._seen, self._last_drop = dropped - self._seen, dropped, now
             if not self.active and self.actions:
                 self.active = True
-                self.episodes += 1
                 self.log("error", f"overloaded: {new} messages dropped (the engine's queue is full): running the "
                                   f"fail-safe actions {', '.join(self.actions)} (~overload_actions)")
                 self._send("start", now, runners)

@@ -81,9 +81,9 @@ def build(spec: CheckedSpec, rules: Dict[str, Any], active: List[int], topics: D
     mvalues.append(("active behaviours", ", ".join(str(i) for i in active) or "none"))
     level = ERROR if monitor.get("last reload error") or monitor.get("action failures") else OK
     msg = f"enforcing {spec.path}: {len(spec.rules)} rules, {len(spec.behaviours)} behaviours"
-    if str(monitor.get("overloaded", "no")).startswith("yes"):
+    if monitor.get("overloaded", "no") != "no":
         level = ERROR
-        msg += f" (OVERLOADED, dropping messages: {monitor['overloaded'][5:]})"
+        msg += f" (OVERLOADED, dropping messages: {monitor['overloaded']})"
     if str(monitor.get("master", "connected")) != "connected":
         level = max(level, WARN)
         msg += f" (master {monitor['master']})"

@@ -164,6 +164,7 @@ def test_custom_plugin_named_in_yaml_is_called(ros, tmp_path):
     ({}, "~spec is required"),
     ({"spec": "/nonexistent/s.rbs"}, "/nonexistent/s.rbs: error: cannot read spec: no such file"),
     ({"spec": "SPEC", "rate": "fast"}, "~rate must be a rate from 1 to 1000 Hz"),
+    ({"spec": "SPEC", "queue_size": "big"}, "~queue_size must be a whole number of messages from 10 to 10000000"),
     ({"spec": "BROKEN"}, "error: undefined name 'LIMT'"),
     ({"spec": "BADLIB"}, "action 'stop': unknown message type 'geometry_msgs/Twst'"),
 ])

@@ -27,5 +27,5 @@ def test_a_rejected_reload_stays_error_whatever_the_master():
 
 
 def test_an_overloaded_monitor_is_error_and_names_the_fail_safe_actions():
-    e = monitor_entry(master="connected", overloaded="yes: running stop")
+    e = monitor_entry(master="connected", overloaded="running stop")
     assert e.level == status.ERROR and "OVERLOADED, dropping messages: running stop" in e.message
