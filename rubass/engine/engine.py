@@ -15,6 +15,7 @@ from typing import Any, Dict, Iterable, List, Optional, Set, Tuple
 from ..lang import ast
 from ..lang.model import CheckedBehaviour, CheckedSpec
 from .evaluate import Compiled, Compiler
+from .explain import Explainer, Witness
 from .fields import FieldError, extract
 from .store import Store
 from .temporal import ForTimer
@@ -32,6 +33,8 @@ class Event:
     value: Any = None
     actions: Tuple[str, ...] = ()
     line: int = 0
+    name: str = ""  # the behaviour's name (§14), "" when unnamed
+    witness: Optional[Witness] = None  # at a start: the true rules and the values they read (explain.py)
 
 
 @dataclass
@@ -58,6 +61,7 @@ class Engine:
         self.store = Store(now)
         self.orphans: List[_Behaviour] = []  # active behaviours of a replaced spec that this one lacks
         self.field_errors: Dict[Tuple[str, str], str] = {}
+        self._explainer: Optional[Explainer] = None
         compiler = Compiler(self.store)
         self._keys = [r.key for r in spec.rules]
         self._index = {k: i for i, k in enumerate(self._keys)}
@@ -299,6 +303,12 @@ class Engine:
         keys = [e.key for e in ast.walk(cond) if isinstance(e, ast.RuleRef)]
         return sorted({k for k in keys if self.store.rules.get(k) is True})
 
+    def explain(self, index: int) -> Witness:
+        """Why behaviour `index` (1-based) holds now: computed at its start only, off the message path."""
+        if self._explainer is None:
+            self._explainer = Explainer(self.spec, self.store, lambda e: Compiler(self.store)._fn(e, []))
+        return self._explainer.explain(index)
+
     def active_behaviours(self) -> List[int]:
         return [j + 1 for j, b in enumerate(self._behaviours) if b.active]
 
@@ -320,7 +330,8 @@ class Engine:
             self._schedule(b.compiled, 1, j)
             if b.value is True and not b.active:
                 b.active = True
-                events.append(Event(now, "start", j + 1, actions=b.actions, line=b.checked.span.line))
+                events.append(Event(now, "start", j + 1, actions=b.actions, line=b.checked.span.line,
+                                    witness=self.explain(j + 1)))
             elif b.value is not True and b.active and not b.checked.latched:
                 b.active = False
                 events.append(Event(now, "release", j + 1, actions=b.actions, line=b.checked.span.line))

@@ -1,0 +1,186 @@
+"""Why a behaviour started: its true rules and the values they read, taken at the transition.
+
+A witness is computed only when a behaviour starts (never on the message path): the rules its
+condition uses, directly or through other rules, that are true at that instant, and every topic
+field and function value that the condition and those rules read, as the engine's store holds
+them then. Labels are written as in a spec without the `topic`/`node` keywords, so a safety
+engineer can match them to the rules: `/odom.twist.twist.linear.x`, `age(/cmd_vel)`,
+`cpu(controller)`, `min(/scan.ranges[0:90])`. Values are SI (a share of one core for cpu,
+bytes for memory); each function's unit is given beside it.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any, Callable, Dict, List, Optional, Sequence, Tuple
+
+from ..lang import ast
+from ..lang.model import CheckedSpec
+from .store import Store
+from .values import UNKNOWN
+
+# functions whose value is a pure read of the store (no state of their own), with their unit
+_UNITS = {"age": "s", "stamp_age": "s", "frequency": "Hz", "cpu": "cores", "memory": "B", "alive": ""}
+_ARRAY_FNS = ("min", "max", "len")
+
+
+@dataclass(frozen=True)
+class Reading:
+    """One value a condition read: its label, its value (None when unknown) and its unit."""
+
+    term: str
+    value: Any
+    unit: str = ""
+
+    def text(self) -> str:
+        v = self.value
+        if v is None:
+            shown = "unknown"
+        elif isinstance(v, bool):
+            shown = "true" if v else "false"
+        elif isinstance(v, float):
+            shown = f"{v:.6g}"
+        else:
+            shown = repr(v) if isinstance(v, str) else str(v)
+        return f"{self.term} = {shown}{(' ' + self.unit) if self.unit and v is not None else ''}"
+
+
+@dataclass(frozen=True)
+class Witness:
+    """What made a behaviour start: its attributes, the true rules and the values read."""
+
+    rules: Tuple[str, ...]
+    readings: Tuple[Reading, ...]
+    attrs: Tuple[Tuple[str, Tuple[str, ...]], ...] = ()
+
+    def values(self) -> Dict[str, Any]:
+        """term -> value (None when unknown), as JSON shows them."""
+        return {r.term: r.value for r in self.readings}
+
+    def units(self) -> Dict[str, str]:
+        return {r.term: r.unit for r in self.readings if r.unit}
+
+    def as_json(self) -> Dict[str, Any]:
+        return {"rules": list(self.rules), "witnesses": self.values(), "units": self.units(),
+                "attrs": {k: list(v) for k, v in self.attrs}}
+
+
+def label(e: ast.Expr) -> Optional[str]:
+    """How a witness names a term, or None for what is not a reading."""
+    if isinstance(e, ast.TopicRef):
+        return e.topic + e.path_text
+    if isinstance(e, ast.Call) and (e.func in _UNITS or e.func in _ARRAY_FNS):
+        if e.func in _ARRAY_FNS and (len(e.args) != 1 or not isinstance(e.args[0], ast.TopicRef)):
+            return None  # min(x, y): arithmetic, its operands are readings of their own
+        parts: List[str] = []
+        for a in e.args:
+            if isinstance(a, ast.TopicRef):
+                parts.append(a.topic + a.path_text)
+            elif isinstance(a, ast.NodeRef):
+                parts.append(a.node)
+            elif isinstance(a, ast.Lit) and isinstance(a.value, float):
+                parts.append(f"{a.value:g} s")
+            else:
+                return None
+        return f"{e.func}({', '.join(parts)})"
+    return None
+
+
+def _json_value(v: Any) -> Any:
+    if v is UNKNOWN or v is None:
+        return None
+    if isinstance(v, float) and not math.isfinite(v):
+        return None if math.isnan(v) else v
+    if isinstance(v, (bool, float, str)):
+        return v
+    return _ARRAY  # an array: its min/max/len is the reading, not thousands of elements
+
+
+_ARRAY = object()
+
+
+class Explainer:
+    """Builds witnesses for one engine's behaviours; readers are compiled at the first start."""
+
+    def __init__(self, spec: CheckedSpec, store: Store,
+                 compile_term: Callable[[ast.Expr], Callable[[], Any]]) -> None:
+        self.spec, self.store, self._compile = spec, store, compile_term
+        self._rules = {r.key: r for r in spec.rules}
+        self._readers: Dict[int, List[Tuple[str, str, Callable[[], Any]]]] = {}
+
+    def explain(self, index: int) -> Witness:
+        """The witness of behaviour `index` (1-based) at the store's current instant."""
+        b = self.spec.behaviours[index - 1]
+        true_rules = self._true_rules(b.cond)
+        readings: List[Reading] = []
+        seen = set()
+        for owner in [b.cond] + [self._rules[k].expr for k in true_rules]:
+            for term, unit, read in self._readers_of(owner):
+                if term in seen:
+                    continue
+                seen.add(term)
+                try:
+                    value = _json_value(read())
+                except Exception:  # a witness must never break the engine
+                    value = None
+                if value is not _ARRAY:
+                    readings.append(Reading(term, value, unit))
+        attrs = tuple(sorted((k, tuple(v)) for k, v in (getattr(b, "attrs", None) or {}).items()))
+        return Witness(tuple(true_rules), tuple(readings), attrs)
+
+    def _true_rules(self, cond: ast.Expr) -> List[str]:
+        out: List[str] = []
+        stack = _rule_refs(cond)
+        while stack:
+            key = stack.pop(0)
+            if key in out or self.store.rules.get(key) is not True or key not in self._rules:
+                continue
+            out.append(key)
+            stack.extend(_rule_refs(self._rules[key].expr))
+        return out
+
+    def _readers_of(self, expr: ast.Expr) -> List[Tuple[str, str, Callable[[], Any]]]:
+        key = id(expr)
+        cached = self._readers.get(key)
+        if cached is not None:
+            return cached
+        out: List[Tuple[str, str, Callable[[], Any]]] = []
+        for e in _terms(expr):
+            term = label(e)
+            if term is None:
+                continue
+            if isinstance(e, ast.TopicRef):
+                fields, slot = self.store.fields, (e.topic, e.path)
+                out.append((term, "", lambda f=fields, s=slot: f.get(s, UNKNOWN)))  # type: ignore[misc]
+                continue
+            try:
+                fn = self._compile(e)
+            except Exception:  # a construct this explainer cannot read alone: leave it out
+                continue
+            out.append((term, _UNITS.get(e.func, ""), fn))  # type: ignore[union-attr]
+        self._readers[key] = out
+        return out
+
+
+def _rule_refs(expr: ast.Expr) -> List[str]:
+    return [e.key for e in ast.walk(expr) if isinstance(e, ast.RuleRef)]
+
+
+def _terms(expr: ast.Expr) -> Sequence[ast.Expr]:
+    """Readings in reading order; a function's own topic argument is not read separately,
+    nor is a whole array (its min/max/len is)."""
+    out: List[ast.Expr] = []
+
+    def visit(e: ast.Expr) -> None:
+        if isinstance(e, ast.Call) and label(e) is not None:
+            out.append(e)
+            return
+        if isinstance(e, ast.TopicRef):
+            if e.path:
+                out.append(e)
+            return
+        for c in ast.children(e):
+            visit(c)
+
+    visit(expr)
+    return out

@@ -1,0 +1,102 @@
+"""Every start explains itself: the true rules and the values they read, at the transition only."""
+import json
+import os
+import time
+
+from rubass.engine import Engine
+from rubass.engine.explain import label
+from rubass.lang import ast, check_text
+
+from conftest import ROOT
+
+LIB = os.path.join(ROOT, "docs", "examples", "actions.yaml")
+
+SPEC = """action primitive stop, warn;
+entity base: controller {
+  rules:
+    too_fast: topic /odom.twist.twist.linear.x > 0.5 m/s;
+    silent: age(topic /cmd_vel) > 0.5 s;
+    hot: cpu(node controller) > 90 %;
+    close: min(topic /scan.ranges) < 0.4 m;
+    unused: topic /odom.pose.pose.position.x > 100;
+}
+if (base.too_fast or base.unused) then { stop; }
+if (base.silent) then { warn; }
+if (base.hot and base.close) then { stop; }
+"""
+
+
+def engine():
+    e = Engine(check_text(SPEC, os.path.join(ROOT, "x.rbs"), [LIB]), 0.0)
+    e.evaluate_all(0.0)
+    return e
+
+
+def odom(vx, x=0.0):
+    return {"twist": {"twist": {"linear": {"x": vx}}}, "pose": {"pose": {"position": {"x": x}}}}
+
+
+def test_start_carries_true_rules_and_field_values():
+    e = engine()
+    events = e.on_message("/odom", 0.3, odom(0.62))
+    (start,) = [ev for ev in events if ev.kind == "start"]
+    w = start.witness
+    assert w.rules == ("base.too_fast",)  # base.unused is false: not a cause
+    assert w.values()["/odom.twist.twist.linear.x"] == 0.62
+    assert "/odom.pose.pose.position.x" not in w.values()  # read only by a false rule: not a cause
+
+
+def test_age_witness_has_its_unit_and_the_deadline_value():
+    e = engine()
+    e.on_message("/cmd_vel", 0.2, None)
+    events = e.advance(2.0)
+    (start,) = [ev for ev in events if ev.kind == "start"]
+    assert start.behaviour == 2 and start.witness.rules == ("base.silent",)
+    age = start.witness.values()["age(/cmd_vel)"]
+    assert 0.5 < age < 0.5001  # the instant of the crossing, not a later tick
+    assert start.witness.units()["age(/cmd_vel)"] == "s"
+    assert "age(/cmd_vel) = 0.5" in start.witness.readings[0].text()
+
+
+def test_node_and_array_functions_are_read_but_not_whole_arrays():
+    e = engine()
+    e.on_node_sample("controller", 0.1, True, 0.95, 1e6)
+    events = e.on_message("/scan", 0.2, {"ranges": [1.0, 0.3, 2.0]})
+    (start,) = [ev for ev in events if ev.kind == "start"]
+    vals = start.witness.values()
+    assert vals == {"cpu(controller)": 0.95, "min(/scan.ranges)": 0.3}
+    assert start.witness.units()["cpu(controller)"] == "cores"
+    assert json.dumps(start.witness.as_json())  # JSON-ready
+
+
+def test_releases_and_rule_events_carry_no_witness():
+    e = engine()
+    events = e.on_message("/odom", 0.1, odom(0.62)) + e.on_message("/odom", 0.2, odom(0.0))
+    assert [ev.kind for ev in events if ev.witness is not None] == ["start"]
+
+
+def test_labels():
+    assert label(ast.TopicRef("/scan", ("ranges", 0))) == "/scan.ranges[0]"
+    assert label(ast.Call("frequency", (ast.TopicRef("/odom"), ast.Lit(2.0)))) == "frequency(/odom, 2 s)"
+
+
+def test_witnesses_cost_nothing_on_the_message_path():
+    """Messages that start nothing never build a witness: same speed with explain disabled."""
+    e = engine()
+    calls = []
+    real = e.explain
+    e.explain = lambda i: calls.append(i) or real(i)
+    for k in range(2000):
+        e.on_messages(k * 1e-4, [("/odom", odom(0.1)), ("/cmd_vel", None)])
+    assert calls == []
+    e.on_messages(0.3, [("/odom", odom(0.9)), ("/cmd_vel", None)])
+    assert calls == [1]
+
+
+def test_explain_is_cheap_at_the_transition():
+    e = engine()
+    e.on_message("/odom", 1.0, odom(0.62))
+    t0 = time.perf_counter()
+    for _ in range(200):
+        e.explain(1)
+    assert (time.perf_counter() - t0) / 200 < 0.005  # generous on a loaded machine
