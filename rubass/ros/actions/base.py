@@ -31,7 +31,9 @@ class Context:
 
     @property
     def ident(self) -> Any:
-        return self.behaviour if self.key is None else self.key
+        """Who holds the action: the behaviour and the call's arguments, so that two calls of one
+        action in one behaviour (`warn("alpha"); warn("beta");`) are two holders, not one."""
+        return (self.behaviour if self.key is None else self.key, self.args)
 
 
 @dataclass

@@ -8,7 +8,7 @@ from __future__ import annotations
 import collections
 import threading
 import time
-from typing import Any, Callable, Deque, Optional, Set, Tuple
+from typing import Any, Callable, Deque, Dict, Optional, Set, Tuple
 
 from .base import ActionPlugin, ActionStats, Context
 
@@ -27,6 +27,7 @@ class ActionRunner:
         self._queue: Deque[Tuple[str, Context]] = collections.deque()
         self._hold_pending = False
         self._active: Set[Any] = set()  # identities of the behaviours this action is active for
+        self._held: Dict[Any, Context] = {}  # each holder's start context (carried across a reload)
         self._stop = False
         self._next_periodic = float("inf")
         self._last_log = 0.0
@@ -49,6 +50,7 @@ class ActionRunner:
                     return
                 first = not self._active
                 self._active.add(ctx.ident)
+                self._held[ctx.ident] = ctx
                 self.plugin.active = True
                 if per or first:
                     self._queue.append((kind, ctx))
@@ -56,6 +58,7 @@ class ActionRunner:
                 if ctx.ident not in self._active:
                     return
                 self._active.discard(ctx.ident)
+                self._held.pop(ctx.ident, None)
                 if not self._active:
                     self.plugin.active = False
                 if per or not self._active:
@@ -67,6 +70,26 @@ class ActionRunner:
                 self._queue.append((kind, ctx))
             if len(self._queue) > MAX_PENDING:
                 self._compact()
+            self._cond.notify()
+
+    def adopt(self, old: "ActionRunner") -> None:
+        """Take over what the runner this one replaces (same action name, a reload changed its
+        definition) holds: its holders stay holders and the action starts at once here, so a
+        latched 20 Hz stop goes on across the reload (issue 13)."""
+        with old._cond:
+            held = dict(old._held)
+        if not held:
+            return
+        with self._cond:
+            first = not self._active
+            for ident, ctx in held.items():
+                if ident not in self._active:
+                    self._active.add(ident)
+                    self._held[ident] = ctx
+                    if self.plugin.per_behaviour or first:
+                        self._queue.append(("start", ctx))
+                        first = False
+            self.plugin.active = True
             self._cond.notify()
 
     def _compact(self) -> None:
@@ -138,7 +161,9 @@ class ActionRunner:
                     if self._stop and kind != "release":
                         return
                     now = time.monotonic()
-                    if now >= retry_at or self._queue:  # a new phase: is this one superseded?
+                    # only a phase that supersedes this one cuts the wait: a hold queued behind a
+                    # failing start must not turn the backoff into a spin (100 % of a core)
+                    if now >= retry_at or (self._queue and self._superseded(kind, ctx)):
                         break
                     self._cond.wait(min(retry_at, self._next_periodic) - now)
                 self._periodic_if_due()
