@@ -11,8 +11,15 @@ def _fmt(x: Any, scale: float = 1.0, digits: int = 2) -> str:
 
 
 def print_table(data: Dict[str, Any], out: TextIO) -> bool:
-    """Print the table; True when every row stopped every time and (b) met its target."""
-    ok = True
+    """Print the table; True when every row stopped every time and (b) met its target. An
+    interrupted experiment (data["interrupted"]) says so, and marks the rows it cut short."""
+    stop = data.get("interrupted")
+    ok = not stop
+    if stop:
+        cut = stop.get("cut_short")
+        out.write(f"\nINTERRUPTED by {stop['signal']}: the table holds only the {stop['finished_runs']} finished runs"
+                  + (f"; the run cut short ({cut['row']} run {cut['rep'] + 1}) counts in no figure, its bag: {cut['bag']}"
+                     if cut else "") + "\n")
     out.write("\nTable 1 (seconds). (a): as the paper defines each row (from the fault, the first command over\n"
               "the limit, the crossing of the border, or the start of the CPU loop, to the stop reaching the base).\n"
               "(b): the monitor's own delay, from the instant its rule became due to the stop reaching the base (ms).\n\n")
@@ -28,7 +35,8 @@ def print_table(data: Dict[str, Any], out: TextIO) -> bool:
                   f"{_fmt(a.get('avg')):>13} {_fmt(a.get('sd')):>5} {_fmt(a.get('min')):>5} {_fmt(a.get('max')):>5} | "
                   f"{_fmt(b.get('avg'), 1000, 1):>11} {_fmt(b.get('sd'), 1000, 1):>5} {_fmt(b.get('min'), 1000, 1):>5} "
                   f"{_fmt(b.get('max'), 1000, 1):>5} {_fmt(b.get('p99'), 1000, 1):>5} | "
-                  f"{stopped}{'' if r['stopped'] == r['runs'] else '  NOT EVERY TIME'}\n")
+                  f"{stopped}{'' if r['stopped'] == r['runs'] else '  NOT EVERY TIME'}"
+                  f"{'  (interrupted)' if r.get('interrupted') else ''}\n")
     notes = [f"{r['row']}: {r['note']}" for r in data["rows"] if r["note"]]
     errors = [f"{r['row']}: {e}" for r in data["rows"] for e in r["errors"]]
     if notes:

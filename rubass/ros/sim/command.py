@@ -1,12 +1,22 @@
-"""`rubass experiments [--reps N] [--only ROW…] [--out DIR]`: the paper's Table 1, reproduced."""
+"""`rubass experiments [--reps N] [--only ROW…] [--out DIR]`: the paper's Table 1, reproduced.
+
+SIGINT, SIGTERM or SIGHUP stops every process it started, closes the bag of the run in
+progress, prints and saves the table of the finished runs marked as interrupted, and exits
+128 + the signal (130, 143, 129)."""
 from __future__ import annotations
 
 import argparse
 import json
 import os
 import sys
+from dataclasses import asdict
+from typing import TYPE_CHECKING, Any, Dict, List
 
-from ...sim.rows import ROWS, row
+from ...sim.rows import ROWS, Row, row
+from .procs import Interrupted, Supervisor
+
+if TYPE_CHECKING:
+    from .runner import Outcome
 
 
 def register(sub: "argparse._SubParsersAction[argparse.ArgumentParser]") -> None:
@@ -34,20 +44,52 @@ def run(args: argparse.Namespace) -> int:
         print("rubass experiments: error: ROS 1 is not installed (no rosmaster); run tools/demo.sh, which installs it",
               file=sys.stderr)
         return 1
+    out = os.path.abspath(args.out)
+    sup = Supervisor()
+    try:
+        with sup:
+            return _run(rows, args.reps, out, sup)
+    except Interrupted as exc:  # a signal after the runs (table, plot): the processes are stopped
+        print(f"rubass experiments: interrupted by {exc.name}", file=sys.stderr)
+        return exc.exit_status
+
+
+def _run(rows: List[Row], reps: int, out: str, sup: Supervisor) -> int:
     from ...sim.table import plot, print_table
     from .runner import main_loop, results_json
 
-    out = os.path.abspath(args.out)
-    print(f"rubass experiments: {len(rows)} rows x {args.reps} runs; results in {out}", file=sys.stderr)
-    results = main_loop(rows, args.reps, out)
-    data = results_json(rows, results)
+    print(f"rubass experiments: {len(rows)} rows x {reps} runs; results in {out}", file=sys.stderr)
+    outcome = main_loop(rows, reps, out, sup)
+    data = results_json(rows, outcome.results)
+    if outcome.signal is not None:
+        data = _mark_interrupted(data, outcome, reps)
     ok = print_table(data, sys.stdout)
     with open(os.path.join(out, "table.json"), "w") as fh:
         json.dump(data, fh, indent=1)
+    sys.stdout.flush()
     png = os.path.join(out, "table.png")
-    plot(data, png)
-    print(f"\ntable: {os.path.join(out, 'table.json')}\nplot:  {png}\nbags:  {os.path.join(out, 'runs')}/ROW/N/run.bag "
-          f"(rubass replay SPEC BAG)")
+    if outcome.signal is None:
+        plot(data, png)
+    bags = f"{os.path.join(out, 'runs')}/ROW/N/run.bag (rubass replay SPEC BAG)"
+    print(f"\ntable: {os.path.join(out, 'table.json')}\nplot:  {png if outcome.signal is None else '(not drawn: interrupted)'}"
+          f"\nbags:  {bags}")
+    if outcome.signal is not None:
+        exc = Interrupted(outcome.signal)
+        print(f"rubass experiments: interrupted by {exc.name}: {len(outcome.results)} of {len(rows) * reps} runs "
+              f"finished; every process it started is stopped", file=sys.stderr)
+        return exc.exit_status
     if not ok:
         print("rubass experiments: some row did not stop every time or missed the (b) target", file=sys.stderr)
     return 0 if ok else 1
+
+
+def _mark_interrupted(data: Dict[str, Any], outcome: "Outcome", reps: int) -> Dict[str, Any]:
+    """The table of an interrupted experiment: only the rows with a finished run, each saying
+    how many of its runs finished; the run cut short is named, not counted."""
+    cut = outcome.cut_short
+    data["interrupted"] = {
+        "signal": Interrupted(outcome.signal or 0).name, "finished_runs": len(outcome.results),
+        "cut_short": {k: v for k, v in asdict(cut).items() if k != "events"} if cut else None,
+    }
+    data["rows"] = [dict(r, interrupted=r["runs"] < reps) for r in data["rows"] if r["runs"] > 0]
+    return data

@@ -2,7 +2,10 @@
 
 Each run starts its own processes (base, driver, fault injector, the monitor, rosbag record)
 on the runner's master, lets the robot drive, injects the fault, and waits for the stop to
-reach the base. The nodes log wall-clock events to one file per run, from which:
+reach the base. Every process is the Supervisor's (procs.py): a stop signal (SIGINT, SIGTERM,
+SIGHUP) ends the run in progress cleanly (its bag closed) and keeps the finished runs; the
+processes die with the runner even when it is SIGKILLed. The nodes log wall-clock events to one
+file per run, from which:
 (a) the paper's time: from the row's origin (the fault, the first command over the limit,
     the crossing of the border, the start of the CPU loop) to the stop reaching the base;
 (b) the monitor's own delay: from the instant its rule became due, computed afterwards by
@@ -18,14 +21,15 @@ import subprocess
 import sys
 import time
 from dataclasses import asdict, dataclass, field
-from typing import Any, Dict, List, Optional
+from typing import Any, Dict, List, Optional, Tuple
 
 from ...lang import load_spec
 from ...replay.run import replay
 from ...sim.rows import Row
 from ..bag import BagError, open_bag, read
-from ..master import ROOT, PrivateMaster, stop_processes, wait_for_service
+from ..master import ROOT, PrivateMaster, wait_for_service
 from .eventlog import read_events
+from .procs import Interrupted, Supervisor
 
 PY = "/usr/bin/python3"
 CONFIG = os.path.join(ROOT, "config")
@@ -43,15 +47,28 @@ class RunResult:
     due_source: str = ""
     error: str = ""
     bag: str = ""
+    interrupted: bool = False        # a stop signal ended this run; it counts in no figure
     events: List[Dict[str, Any]] = field(default_factory=list)
+
+
+@dataclass
+class Outcome:
+    """What main_loop ran: the finished runs, and if a stop signal ended it, which one and the
+    run it cut short (its bag closed, its folder kept)."""
+    results: List[RunResult]
+    signal: Optional[int] = None
+    cut_short: Optional[RunResult] = None
 
 
 class Session:
     """A private rosmaster for the whole experiment, and this process as a ROS node."""
 
-    def __init__(self, out: str) -> None:
+    def __init__(self, out: str, sup: Supervisor) -> None:
         self.out = out
-        self.master = PrivateMaster(os.path.join(out, "ros_home"))
+        self.sup = sup
+        with sup.deferred():  # the master is the supervisor's from its first instant
+            self.master = PrivateMaster(os.path.join(out, "ros_home"))
+            sup.adopt(self.master.process)
         self.env = self.master.env
         self.master.join()
         import rospy
@@ -63,8 +80,9 @@ class Session:
     def close(self) -> None:
         import rospy
 
-        rospy.signal_shutdown("experiments done")
-        self.master.stop()
+        with self.sup.deferred(raise_after=False):
+            rospy.signal_shutdown("experiments done")
+            self.sup.stop_all()
 
 
 def _spec_for(row: Row, run_dir: str) -> str:
@@ -87,7 +105,22 @@ def _bag_topics(row: Row) -> List[str]:
             "/wheel_left/safety_cmd", "/wheel_right/safety_cmd", "/rubass/events", "/sim/fault"]
 
 
+def _recorder(bag: str, topics: List[str]) -> Tuple[List[str], int]:
+    """rosbag's `record` program itself (the `rosbag record` wrapper exits before it, so it
+    could not be waited for): the command line, and SIGINT, which closes the bag cleanly."""
+    try:
+        from roslib.packages import find_node
+
+        found = find_node("rosbag", "record")
+    except Exception:  # noqa: BLE001 - any failure: the wrapper
+        found = []
+    program = found[:1] if found else ["rosbag", "record"]
+    return program + ["--tcpnodelay", "-O", bag] + topics, signal.SIGINT
+
+
 def run_once(session: Session, row: Row, rep: int) -> RunResult:
+    """One run of a row; a stop signal ends it early (result.interrupted) with every process
+    stopped and the bag closed."""
     run_dir = os.path.join(session.out, "runs", row.name.replace(" ", "_").replace("(", "").replace(")", ""), str(rep))
     shutil.rmtree(run_dir, ignore_errors=True)
     os.makedirs(run_dir)
@@ -95,10 +128,9 @@ def run_once(session: Session, row: Row, rep: int) -> RunResult:
     spec_path = _spec_for(row, run_dir)
     procs: List[subprocess.Popen] = []
 
-    def spawn(name: str, args: List[str]) -> subprocess.Popen:
-        log = open(os.path.join(run_dir, f"{name}.log"), "w")
-        p = subprocess.Popen(args, env=session.env, stdout=log, stderr=subprocess.STDOUT, cwd=run_dir,
-                             start_new_session=True)
+    def spawn(name: str, args: List[str], stop_signal: int = signal.SIGTERM) -> subprocess.Popen:
+        with open(os.path.join(run_dir, f"{name}.log"), "w") as log:
+            p = session.sup.spawn(args, env=session.env, stdout=log, cwd=run_dir, stop_signal=stop_signal)
         procs.append(p)
         return p
 
@@ -114,8 +146,14 @@ def run_once(session: Session, row: Row, rep: int) -> RunResult:
         spawn("driver", [PY, "-m", "rubass.ros.sim.driver", "__name:=controller", "_robot:=frobit", ev,
                          "_goal_x:=4.0", "_goal_y:=1.0"])
     bag = os.path.join(run_dir, "run.bag")
-    recorder = spawn("rosbag", ["rosbag", "record", "--tcpnodelay", "-O", bag] + _bag_topics(row))
+    recorder = spawn("rosbag", *_recorder(bag, _bag_topics(row)))
     result = RunResult(row.name, rep, False, bag=bag)
+
+    def close_bag() -> None:
+        session.sup.stop([recorder])
+        # with the `rosbag record` wrapper, its child renames run.bag.active after the wrapper exits
+        _wait(lambda: not os.path.exists(bag + ".active"), 15, "the bag")
+
     try:
         if row.robot == "frobit":
             _wait(lambda: os.path.lexists(os.path.join(run_dir, "board")), 15, "the safety board's port")
@@ -134,16 +172,21 @@ def run_once(session: Session, row: Row, rep: int) -> RunResult:
         while time.time() < end and not any(e["event"] == "stop_received" for e in read_events(events_file)):
             time.sleep(0.01)
         time.sleep(0.3)  # let the recorder catch the last messages
-        stop_processes([recorder], signal.SIGINT)
-        # rosbag's recorder (a child process) renames run.bag.active to run.bag after its parent exits
-        _wait(lambda: os.path.exists(bag) and not os.path.exists(bag + ".active"), 15, "the bag")
+        close_bag()
+        _wait(lambda: os.path.exists(bag), 1, "the bag")
         result.events = read_events(events_file)
         _measure(row, result, spec_path, fault_sent)
+    except Interrupted as exc:
+        result.interrupted, result.error = True, f"interrupted by {exc.name}"
     except Exception as exc:  # a run that breaks is reported, and the others go on
         result.error = f"{exc.__class__.__name__}: {exc}"
     finally:
-        stop_processes([p for p in procs if p is not recorder])
-        stop_processes([recorder], signal.SIGINT)
+        session.sup.stop([p for p in reversed(procs) if p is not recorder])
+        try:
+            with session.sup.deferred(raise_after=False):
+                close_bag()
+        except RuntimeError as exc:
+            result.error = result.error or str(exc)
     return result
 
 
@@ -214,20 +257,32 @@ def results_json(rows: List[Row], results: List[RunResult]) -> Dict[str, Any]:
     return out
 
 
-def main_loop(rows: List[Row], reps: int, out: str, progress: Any = sys.stderr) -> List[RunResult]:
+def main_loop(rows: List[Row], reps: int, out: str, sup: Supervisor, progress: Any = sys.stderr) -> Outcome:
+    """Every run of every row, until done or a stop signal; every process is stopped on return."""
     os.makedirs(out, exist_ok=True)
-    session = Session(out)
-    results: List[RunResult] = []
+    outcome = Outcome([])
+    session: Optional[Session] = None
     try:
+        session = Session(out, sup)
         for r in rows:
             for rep in range(reps):
                 res = run_once(session, r, rep)
-                results.append(res)
+                if res.interrupted:
+                    outcome.cut_short = res
+                    progress.write(f"  {r.name:<13} run {rep + 1}/{reps}: {res.error}; its bag: {res.bag}\n")
+                    return outcome
+                outcome.results.append(res)
                 a = f"{res.a:.3f} s" if res.a is not None else "-"
                 b = f"{res.b * 1000:.1f} ms" if res.b is not None else "-"
                 progress.write(f"  {r.name:<13} run {rep + 1}/{reps}: stopped={res.stopped} (a) {a} (b) {b}"
                                f"{'  ' + res.error if res.error else ''}\n")
                 progress.flush()
+                sup.check()  # a signal during the run's own cleanup ends the loop here
+    except Interrupted:
+        pass
     finally:
-        session.close()
-    return results
+        if session is not None:
+            session.close()
+        sup.stop_all()
+        outcome.signal = sup.signum
+    return outcome
