@@ -1,0 +1,69 @@
+"""`rubass test FILE.test.yaml… [--junit OUT.xml] [--coverage] [--actions LIB.yaml]`.
+
+Exit 0 when every test passes, 1 when one fails, 2 when a file cannot be run (TESTING.md).
+"""
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+from typing import Dict, List, TextIO
+
+from .coverage import coverage, render
+from .results import FileResult, run_file
+
+
+def register(sub: "argparse._SubParsersAction[argparse.ArgumentParser]") -> None:
+    p = sub.add_parser("test", help="run rule tests (FILE.test.yaml) on the engine, with no master",
+                       description="Run the rule tests of each FILE (docs/testing.md) on the same engine as "
+                                   "replay and the monitor. Exit 0 all pass, 1 a test fails, 2 a file cannot run.")
+    p.add_argument("files", nargs="+", metavar="FILE.test.yaml")
+    p.add_argument("--junit", metavar="OUT.xml", help="write JUnit XML (one testcase per test)")
+    p.add_argument("--coverage", action="store_true",
+                   help="list rules never true, behaviours never started, @id/@hazard values no test covers")
+    p.add_argument("--actions", action="append", default=[], metavar="LIB.yaml",
+                   help="an action library to load besides the spec's imports (repeatable)")
+    p.set_defaults(func=run)
+
+
+def print_results(results: List[FileResult], out: TextIO, err: TextIO) -> None:
+    for r in results:
+        for w in r.warnings:
+            print(w, file=err)
+        if r.error:
+            print(r.error, file=err)
+            continue
+        print(f"{os.path.relpath(r.path)} (spec {os.path.relpath(r.spec_path)})", file=out)
+        for o in r.outcomes:
+            covers = f"  [{', '.join(o.covers)}]" if o.covers else ""
+            print(f"  {'PASS' if o.passed else 'FAIL'}  {o.name}{covers}", file=out)
+            for problem in o.problems:
+                print(f"    {problem}", file=out)
+
+
+def run(args: argparse.Namespace) -> int:
+    results = [run_file(path, args.actions) for path in args.files]
+    print_results(results, sys.stdout, sys.stderr)
+    passed = sum(o.passed for r in results for o in r.outcomes)
+    failed = sum(not o.passed for r in results for o in r.outcomes)
+    if args.coverage:
+        by_spec: Dict[str, List[FileResult]] = {}
+        for r in results:
+            if r.spec is not None:
+                by_spec.setdefault(r.spec.path, []).append(r)
+        for rs in by_spec.values():
+            spec = rs[0].spec
+            assert spec is not None
+            print(render(coverage(spec, [o for r in rs for o in r.outcomes])))
+    if args.junit:
+        from .junit import write_junit
+
+        try:
+            write_junit(results, args.junit)
+        except OSError as exc:
+            print(f"rubass test: error: cannot write {args.junit}: {exc.strerror or exc}", file=sys.stderr)
+            return 2
+    print(f"{passed} passed, {failed} failed")
+    if any(r.error for r in results):
+        return 2
+    return 1 if failed else 0

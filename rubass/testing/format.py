@@ -1,0 +1,286 @@
+"""Reading a test file (TESTING.md) into plain data, with the line of everything for errors."""
+from __future__ import annotations
+
+import os
+from dataclasses import dataclass, field
+from typing import Any, Dict, List, Optional, Tuple
+
+from ..lang.errors import did_you_mean
+from ..lang.units import MEMORY, TIME, FREQUENCY, parse_quantity
+from .messages import MessageError, Path, fields_of, message_class, parse_path
+from .series import GAP, SeriesError, expand
+from .yamlpos import LDict, LList, TestFileError, load
+
+UNSET: Any = object()  # a node-sample value the sample leaves out
+DEFAULT_TOLERANCE = 1e-3
+
+
+@dataclass
+class MessageInput:
+    """One message (or part of one: same topic and instant merge) at a time."""
+
+    time: float
+    topic: str
+    assignments: List[Tuple[Path, Any]]
+    line: int
+
+
+@dataclass
+class TopicInput:
+    topic: str
+    type_name: str
+    cls: Any
+    line: int
+
+
+@dataclass
+class NodeSampleInput:
+    node: str
+    time: float
+    alive: Any
+    cpu: Any
+    memory: Any
+    line: int
+
+
+@dataclass
+class Expect:
+    kind: str  # start, release, never, active
+    name: Any  # a behaviour's name or number, or an action
+    line: int
+    at: float = 0.0
+    start: float = 0.0  # active: from
+    end: float = 0.0  # active: to
+    tolerance: Optional[float] = None
+
+
+@dataclass
+class Case:
+    name: str
+    line: int
+    covers: List[str]
+    duration: Optional[float]
+    tolerance: float
+    topics: Dict[str, TopicInput] = field(default_factory=dict)
+    messages: List[MessageInput] = field(default_factory=list)
+    nodes: List[NodeSampleInput] = field(default_factory=list)
+    expects: List[Expect] = field(default_factory=list)
+
+    @property
+    def end(self) -> float:
+        """The test's duration: as given, else the last input or expected instant + 2 s."""
+        if self.duration is not None:
+            return self.duration
+        times = [m.time for m in self.messages] + [n.time for n in self.nodes]
+        times += [max(e.at, e.end) for e in self.expects]
+        return max(times, default=0.0) + 2.0
+
+
+@dataclass
+class TestFile:
+    path: str
+    spec: str
+    spec_line: int
+    actions: List[str]
+    cases: List[Case]
+
+
+class _Reader:
+    def __init__(self, path: str) -> None:
+        self.path = path
+
+    def fail(self, line: int, message: str) -> TestFileError:
+        return TestFileError(self.path, line, message)
+
+    def mapping(self, value: Any, line: int, what: str, keys: Tuple[str, ...], required: Tuple[str, ...] = ()) -> LDict:
+        if not isinstance(value, LDict):
+            raise self.fail(line, f"{what} must be a mapping")
+        for k in value:
+            if k not in keys:
+                raise self.fail(value.at(k), f"unknown key '{k}' in {what}{did_you_mean(str(k), keys)}"
+                                              f" (keys: {', '.join(keys)})")
+        for k in required:
+            if k not in value:
+                raise self.fail(value.line, f"{what} needs '{k}'")
+        return value
+
+    def seq(self, value: Any, line: int, what: str) -> LList:
+        if not isinstance(value, LList):
+            raise self.fail(line, f"{what} must be a list")
+        return value
+
+    def quantity(self, value: Any, line: int, what: str, dim: Any, unit: str, negative: bool = False) -> float:
+        if isinstance(value, bool) or value is None:
+            raise self.fail(line, f"{what} must be a number (in {unit}), not {value!r}")
+        if isinstance(value, (int, float)):
+            q: Any = (float(value), dim)
+        else:
+            q = parse_quantity(str(value))
+            if q is not None and q[1] == ():
+                q = (q[0], dim) if dim != () else q
+        if q is None or q[1] != dim or q[0] != q[0]:
+            raise self.fail(line, f"{what}: '{value}' is not a quantity in {unit}")
+        if q[0] < 0 and not negative:
+            raise self.fail(line, f"{what} must not be negative")
+        return float(q[0])
+
+    def time(self, value: Any, line: int, what: str) -> float:
+        return self.quantity(value, line, what, TIME, "seconds, e.g. 1.5 s or 200 ms")
+
+    # -- the file ---------------------------------------------------------------------------
+    def read(self) -> TestFile:
+        doc = load(self.path)
+        top = self.mapping(doc, 1, "a test file", ("spec", "actions", "tests"), ("spec", "tests"))
+        spec = top["spec"]
+        if not isinstance(spec, str) or not spec:
+            raise self.fail(top.at("spec"), "spec must be the path of a .rbs file")
+        base = os.path.dirname(os.path.abspath(self.path))
+        listed = top.get("actions", LList())
+        listed = [listed] if isinstance(listed, str) else self.seq(listed, top.at("actions"), "actions")
+        actions = [os.path.join(base, str(a)) for a in listed]
+        tests = self.seq(top["tests"], top.at("tests"), "tests")
+        if not tests:
+            raise self.fail(top.at("tests"), "tests is empty: a file needs at least one test")
+        cases = [self.case(t, tests.at(i), i) for i, t in enumerate(tests)]
+        seen: Dict[str, int] = {}
+        for c in cases:
+            if c.name in seen:
+                raise self.fail(c.line, f"a second test named '{c.name}' (the first is at line {seen[c.name]})")
+            seen[c.name] = c.line
+        return TestFile(self.path, os.path.join(base, spec), top.at("spec"), actions, cases)
+
+    def case(self, value: Any, line: int, i: int) -> Case:
+        t = self.mapping(value, line, "a test", ("name", "covers", "duration", "topics", "nodes", "expect",
+                                                 "tolerance"), ("expect",))
+        name = str(t.get("name", f"test {i + 1}"))
+        covers = t.get("covers", LList())
+        covers = [covers] if isinstance(covers, str) else self.seq(covers, t.at("covers"), "covers")
+        duration = self.time(t["duration"], t.at("duration"), "duration") if "duration" in t else None
+        tol = self.time(t["tolerance"], t.at("tolerance"), "tolerance") if "tolerance" in t else DEFAULT_TOLERANCE
+        case = Case(name, t.line, [str(c) for c in covers], duration, tol)
+        topics = self.mapping(t.get("topics", LDict()), t.at("topics"), "topics", tuple(t.get("topics") or ()))
+        for topic, spec in topics.items():
+            self.topic(case, str(topic), spec, topics.at(topic))
+        nodes = self.mapping(t.get("nodes", LDict()), t.at("nodes"), "nodes", tuple(t.get("nodes") or ()))
+        for node, samples in nodes.items():
+            self.node(case, str(node), samples, nodes.at(node))
+        expects = self.seq(t["expect"], t.at("expect"), "expect")
+        case.expects = [self.expect(e, expects.at(k)) for k, e in enumerate(expects)]
+        return case
+
+    def topic(self, case: Case, topic: str, value: Any, line: int) -> None:
+        if not topic.startswith("/"):
+            topic = "/" + topic
+        t = self.mapping(value, line, f"topic {topic}", ("type", "rate", "start", "field", "fields", "values",
+                                                         "messages"), ("type",))
+        try:
+            cls = message_class(t["type"])
+        except MessageError as exc:
+            raise self.fail(t.at("type"), str(exc)) from None
+        case.topics[topic] = TopicInput(topic, t["type"], cls, line)
+        series = [k for k in ("field", "fields", "values", "rate") if k in t]
+        if series:
+            self.series(case, topic, t)
+        if "messages" in t:
+            msgs = self.seq(t["messages"], t.at("messages"), f"messages of {topic}")
+            for k, m in enumerate(msgs):
+                self.message(case, topic, m, msgs.at(k))
+        if not series and "messages" not in t:
+            raise self.fail(line, f"topic {topic} has no input: give a series (rate, field, values) or messages")
+
+    def series(self, case: Case, topic: str, t: LDict) -> None:
+        if "rate" not in t:
+            raise self.fail(t.line, f"the series of {topic} needs a rate (e.g. rate: 10 Hz)")
+        rate = self.quantity(t["rate"], t.at("rate"), "rate", FREQUENCY, "Hz")
+        if rate <= 0:
+            raise self.fail(t.at("rate"), "rate must be more than 0 Hz")
+        start = self.time(t.get("start", 0.0), t.at("start"), "start")
+        if ("field" in t) == ("fields" in t):
+            raise self.fail(t.line, f"the series of {topic} needs either field + values or fields")
+        if "field" in t:
+            if "values" not in t:
+                raise self.fail(t.line, f"the series of {topic} needs values")
+            columns = [(t["field"], t["values"], t.at("field"), t.at("values"))]
+        else:
+            if "values" in t:
+                raise self.fail(t.at("values"), "with fields, give the values per field: fields: {PATH: VALUES}")
+            fields = self.mapping(t["fields"], t.at("fields"), "fields", tuple(t["fields"] or ()))
+            columns = [(k, v, fields.at(k), fields.at(k)) for k, v in fields.items()]
+        steps: List[Tuple[Path, List[Any]]] = []
+        for path_text, values, pline, vline in columns:
+            try:
+                path = parse_path(path_text)
+                steps.append((path, expand(values)))
+            except MessageError as exc:
+                raise self.fail(pline, str(exc)) from None
+            except SeriesError as exc:
+                raise self.fail(vline, f"values of {path_text}: {exc}") from None
+        lengths = {len(s) for _, s in steps}
+        if len(lengths) != 1:
+            raise self.fail(t.at("fields"), f"the fields of {topic} have series of different lengths "
+                                            f"({', '.join(str(len(s)) for _, s in steps)} steps)")
+        for k in range(lengths.pop()):
+            parts = [(path, s[k]) for path, s in steps if s[k] is not GAP]
+            if parts:
+                line = t.at("values") if "values" in t else t.at("fields")
+                case.messages.append(MessageInput(round(start + k / rate, 9), topic, parts, line))
+
+    def message(self, case: Case, topic: str, value: Any, line: int) -> None:
+        if not isinstance(value, LDict) or "at" not in value:
+            raise self.fail(line, f"a message of {topic} is a mapping with 'at' and its fields")
+        at = self.time(value["at"], value.at("at"), "at")
+        rest = {k: v for k, v in value.items() if k != "at"}
+        try:
+            parts = fields_of(rest)
+        except MessageError as exc:
+            raise self.fail(line, str(exc)) from None
+        case.messages.append(MessageInput(at, topic, parts, line))
+
+    def node(self, case: Case, node: str, value: Any, line: int) -> None:
+        samples = self.seq(value, line, f"the samples of node {node}")
+        for k, s in enumerate(samples):
+            s = self.mapping(s, samples.at(k), f"a sample of node {node}", ("at", "alive", "cpu", "memory"), ("at",))
+            alive = s.get("alive", UNSET)
+            if alive is not UNSET and alive is not None and not isinstance(alive, bool):
+                raise self.fail(s.at("alive"), f"alive must be true or false, not {alive!r}")
+            cpu = s.get("cpu", UNSET)
+            if cpu is not UNSET and cpu is not None:
+                cpu = self.quantity(cpu, s.at("cpu"), "cpu", (), "a share of one core (0.5 or 50 %)")
+            mem = s.get("memory", UNSET)
+            if mem is not UNSET and mem is not None:
+                mem = self.quantity(mem, s.at("memory"), "memory", MEMORY, "bytes (or 50 MB)")
+            at = self.time(s["at"], s.at("at"), "at")
+            case.nodes.append(NodeSampleInput(node, at, alive, cpu, mem, samples.at(k)))
+
+    def expect(self, value: Any, line: int) -> Expect:
+        e = self.mapping(value, line, "an expectation", ("at", "start", "release", "never", "active", "from", "to",
+                                                         "tolerance"))
+        kinds = [k for k in ("start", "release", "never", "active") if k in e]
+        if len(kinds) != 1:
+            raise self.fail(line, "an expectation has one of start, release, never or active")
+        kind = kinds[0]
+        name = e[kind]
+        if isinstance(name, bool) or not isinstance(name, (str, int)) or name == "":
+            raise self.fail(e.at(kind), f"{kind} names a behaviour (name or number) or an action")
+        out = Expect(kind, name, line)
+        if "tolerance" in e:
+            out.tolerance = self.time(e["tolerance"], e.at("tolerance"), "tolerance")
+        allowed = {"start": ("at",), "release": ("at",), "never": (), "active": ("from", "to")}[kind]
+        for k in ("at", "from", "to"):
+            if k in e and k not in allowed:
+                raise self.fail(e.at(k), f"'{k}' does not go with {kind}")
+            if k not in e and k in allowed:
+                raise self.fail(line, f"{kind} needs '{k}'")
+        if kind in ("start", "release"):
+            out.at = self.time(e["at"], e.at("at"), "at")
+        elif kind == "active":
+            out.start = self.time(e["from"], e.at("from"), "from")
+            out.end = self.time(e["to"], e.at("to"), "to")
+            if out.end < out.start:
+                raise self.fail(e.at("to"), "to is before from")
+        return out
+
+
+def read_test_file(path: str) -> TestFile:
+    """The test file at `path`, or TestFileError with the place."""
+    return _Reader(path).read()

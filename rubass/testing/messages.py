@@ -1,0 +1,175 @@
+"""Real ROS message objects for test inputs, built from installed types (genpy), field by field.
+
+Values are checked against the field's type as they are set: a field the type lacks, a string
+for a number or a fraction for an integer is a MessageError saying which field and why.
+"""
+from __future__ import annotations
+
+import io
+import math
+import re
+from typing import Any, Dict, List, Optional, Tuple
+
+_ARRAY = re.compile(r"(.*)\[(\d*)\]$")
+_INTS = {"int8", "uint8", "int16", "uint16", "int32", "uint32", "int64", "uint64", "char", "byte"}
+_FLOATS = {"float32", "float64"}
+_PATH = re.compile(r"([A-Za-z_][A-Za-z0-9_]*)|\[(-?\d+)\]|(\.)")
+
+Path = Tuple[Any, ...]
+
+
+class MessageError(ValueError):
+    """A type that is not installed, or a field or value the type does not allow."""
+
+
+def message_class(type_name: Any) -> Any:
+    """The installed class of `pkg/Name`, or MessageError."""
+    if not isinstance(type_name, str) or not re.fullmatch(r"[A-Za-z_][\w]*/[A-Za-z_]\w*", type_name):
+        raise MessageError(f"'{type_name}' is not a message type (pkg/Name, e.g. nav_msgs/Odometry)")
+    try:
+        import roslib.message
+
+        cls = roslib.message.get_message_class(type_name)
+    except Exception:  # roslib raises assorted errors for unknown packages
+        cls = None
+    if cls is None:
+        raise MessageError(f"message type {type_name} is not installed here (is its Debian package installed?)")
+    return cls
+
+
+def parse_path(text: Any) -> Path:
+    """'twist.twist.linear.x' or 'ranges[0]' -> ('twist', 'twist', 'linear', 'x') / ('ranges', 0)."""
+    if not isinstance(text, str) or not text:
+        raise MessageError("a field path is a string such as twist.twist.linear.x")
+    out: List[Any] = []
+    pos = 0
+    for m in _PATH.finditer(text):
+        if m.start() != pos:
+            break
+        pos = m.end()
+        if m.group(1):
+            out.append(m.group(1))
+        elif m.group(2) is not None:
+            out.append(int(m.group(2)))
+    if pos != len(text) or not out or not isinstance(out[0], str):
+        raise MessageError(f"'{text}' is not a field path (such as twist.twist.linear.x or ranges[0])")
+    return tuple(out)
+
+
+def _text(path: Path) -> str:
+    return "".join(f"[{p}]" if isinstance(p, int) else f".{p}" for p in path).lstrip(".")
+
+
+def _slot_type(obj: Any, name: str, done: Path) -> str:
+    slots = list(getattr(obj, "__slots__", ()))
+    if name not in slots:
+        where = f"'{_text(done)}' ({obj._type})" if done else obj._type
+        raise MessageError(f"{where} has no field '{name}' (fields: {', '.join(slots)})")
+    return obj._slot_types[slots.index(name)]
+
+
+def _nested_class(type_name: str) -> Any:
+    if type_name == "Header":
+        type_name = "std_msgs/Header"
+    return message_class(type_name)
+
+
+def _scalar(slot: str, value: Any, where: str) -> Any:
+    if slot in _FLOATS:
+        if isinstance(value, bool) or not isinstance(value, (int, float)):
+            raise MessageError(f"{where} is a {slot}: {value!r} is not a number")
+        return float(value)
+    if slot in _INTS:
+        if isinstance(value, float) and value.is_integer():
+            value = int(value)
+        if isinstance(value, bool) or not isinstance(value, int):
+            raise MessageError(f"{where} is a {slot}: {value!r} is not an integer")
+        return value
+    if slot == "bool":
+        if value in (0, 1) and not isinstance(value, bool):
+            value = bool(value)
+        if not isinstance(value, bool):
+            raise MessageError(f"{where} is a bool: {value!r} is not true or false")
+        return value
+    if slot == "string":
+        if not isinstance(value, str):
+            raise MessageError(f"{where} is a string: {value!r} is not a string (quote it)")
+        return value
+    if slot in ("time", "duration"):
+        import genpy
+
+        if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+            raise MessageError(f"{where} is a {slot}: {value!r} is not a number of seconds")
+        return (genpy.Time if slot == "time" else genpy.Duration).from_sec(float(value)) if value else \
+            (genpy.Time() if slot == "time" else genpy.Duration())
+    return None  # a message: handled by the caller
+
+
+def convert(slot: str, value: Any, where: str, current: Any = None) -> Any:
+    """`value` (from YAML) as a value of a field of type `slot`; dicts fill `current` in place."""
+    m = _ARRAY.match(slot)
+    if m:
+        if not isinstance(value, (list, tuple)):
+            raise MessageError(f"{where} is an array ({slot}): give a list")
+        if m.group(2) and len(value) != int(m.group(2)):
+            raise MessageError(f"{where} holds exactly {m.group(2)} elements, not {len(value)}")
+        items = [convert(m.group(1), v, f"{where}[{i}]") for i, v in enumerate(value)]
+        return bytes(items) if m.group(1) in ("uint8", "char") else items
+    scalar = _scalar(slot, value, where)
+    if scalar is not None:
+        return scalar
+    if not isinstance(value, dict):
+        raise MessageError(f"{where} is a message ({slot}): give its fields as a mapping")
+    obj = current if current is not None else _nested_class(slot)()
+    for k, v in value.items():
+        setattr(obj, str(k), convert(_slot_type(obj, str(k), ()), v, f"{where}.{k}", getattr(obj, str(k), None)
+                                     if str(k) in obj.__slots__ else None))
+    return obj
+
+
+def assign(msg: Any, path: Path, value: Any) -> None:
+    """Set the field at `path` of `msg` (fields on the way must exist; array elements must exist)."""
+    obj: Any = msg
+    done: Path = ()
+    for i, elem in enumerate(path):
+        last = i == len(path) - 1
+        if isinstance(elem, int):
+            if not isinstance(obj, list) or not -len(obj) <= elem < len(obj):
+                raise MessageError(f"'{_text(done)}' has no element [{elem}]: set the whole list")
+            if last:
+                raise MessageError(f"'{_text(path)}': set the whole array, not one element")
+            obj, done = obj[elem], done + (elem,)
+            continue
+        slot = _slot_type(obj, elem, done)
+        if last:
+            setattr(obj, elem, convert(slot, value, f"'{_text(path)}'", getattr(obj, elem)))
+            return
+        child = getattr(obj, elem)
+        if isinstance(child, (bytes, tuple)):
+            child = list(child)
+            setattr(obj, elem, child)
+        obj, done = child, done + (elem,)
+
+
+def has_header(cls: Any) -> bool:
+    slots = list(getattr(cls, "__slots__", ()))
+    return "header" in slots and cls._slot_types[slots.index("header")] in ("std_msgs/Header", "Header")
+
+
+def build(cls: Any, assignments: List[Tuple[Path, Any]], stamp: Optional[float]) -> Any:
+    """A message of `cls`: defaults, header.stamp = `stamp` when it has a header, then the assignments."""
+    msg = cls()
+    if stamp is not None and has_header(cls):
+        assign(msg, ("header", "stamp"), stamp)
+    for path, value in assignments:
+        assign(msg, path, value)
+    try:
+        msg.serialize(io.BytesIO())  # what a publisher would send: catches what the setters could not
+    except Exception as exc:  # genpy raises SerializationError, struct.error, TypeError…
+        raise MessageError(f"the message does not fit {cls._type}: {exc}") from None
+    return msg
+
+
+def fields_of(mapping: Dict[str, Any]) -> List[Tuple[Path, Any]]:
+    """The assignments of an explicit message's mapping (each top-level key one assignment)."""
+    return [(parse_path(str(k)), v) for k, v in mapping.items()]

@@ -1,0 +1,252 @@
+"""Running one test: its inputs through replay's engine driver, then its expectations checked.
+
+The inputs become what a recording holds: real message objects at their instants and the
+monitor's node samples, so a test runs exactly the path `rubass replay` and the monitor run.
+"""
+from __future__ import annotations
+
+import io
+import json
+from dataclasses import dataclass, field
+from typing import Any, Dict, List, Optional, Set, Tuple
+
+from ..engine import Event
+from ..lang.errors import did_you_mean
+from ..lang.model import CheckedSpec
+from ..replay.run import replay
+from .format import UNSET, Case, Expect, MessageInput
+from .messages import MessageError, assign, has_header
+from .yamlpos import TestFileError
+
+NODE_TOPIC = "/rubass_test/node_samples"  # a pseudo topic: node samples as a monitor records them
+TICK_RATE = 50.0  # as `rubass replay` and the monitor's default tick
+
+
+@dataclass
+class Outcome:
+    """What one test did: pass or fail, why, and what it covered."""
+
+    name: str
+    line: int
+    covers: List[str]
+    passed: bool = True
+    problems: List[str] = field(default_factory=list)
+    events: List[Event] = field(default_factory=list)
+    rules_true: Set[str] = field(default_factory=set)
+    started: Set[int] = field(default_factory=set)
+    duration: float = 0.0
+    elapsed: float = 0.0
+
+
+class _Sample:
+    """A recorded ~node_samples message (what replay reads)."""
+
+    def __init__(self, data: str) -> None:
+        self.data = data
+
+
+def _global(name: str) -> str:
+    return name if name.startswith("/") else "/" + name.lstrip("~")
+
+
+def _stream(spec: CheckedSpec, case: Case, path: str, warnings: List[str]) -> List[Tuple[float, str, Any]]:
+    from ..ros.msgtypes import check_path
+
+    names = {_global(t): t for t in spec.topics}
+    end = case.end
+    readers = spec.field_readers()
+    for topic, t in case.topics.items():
+        if topic not in names:
+            warnings.append(f"{path}:{t.line}: warning: the spec reads no topic {topic}"
+                            f"{did_you_mean(topic, names)}; its messages change nothing")
+            continue
+        for fpath, owners in readers.get(names[topic], {}).items():
+            problem = check_path(t.cls, fpath)
+            if problem:
+                text = "".join(f"[{p}]" if isinstance(p, int) else f".{p}" for p in fpath)
+                raise TestFileError(path, t.line, f"{' and '.join(owners)} reads {topic}{text}, but in "
+                                                  f"{t.type_name}: {problem}")
+    groups: Dict[Tuple[float, str], List[MessageInput]] = {}
+    for m in case.messages:
+        if m.time > end:
+            continue  # after the test's duration: a long series cut short
+        groups.setdefault((m.time, m.topic), []).append(m)
+    out: List[Tuple[float, int, str, Any]] = []
+    for (time, topic), parts in groups.items():
+        cls = case.topics[topic].cls
+        msg = cls()
+        try:
+            if has_header(cls):
+                assign(msg, ("header", "stamp"), time)
+        except MessageError:
+            pass
+        for part in parts:
+            try:
+                for fpath, value in part.assignments:
+                    assign(msg, fpath, value)
+            except MessageError as exc:
+                raise TestFileError(path, part.line, f"{topic} ({case.topics[topic].type_name}): {exc}") from None
+        try:
+            msg.serialize(io.BytesIO())  # what a publisher would send: catches what the setters could not
+        except Exception as exc:  # genpy raises SerializationError, struct.error, TypeError…
+            raise TestFileError(path, parts[0].line, f"the message of {topic} at {time:g} s does not fit "
+                                                     f"{case.topics[topic].type_name}: {exc}") from None
+        if topic in names:
+            out.append((time, 0, names[topic], msg))
+    state: Dict[str, Dict[str, Any]] = {}
+    nodes = {_global(n): n for n in spec.nodes}
+    for s in sorted(case.nodes, key=lambda s: s.time):
+        node = s.node if s.node in spec.nodes else nodes.get(_global(s.node))
+        if node is None:
+            warnings.append(f"{path}:{s.line}: warning: the spec names no node {s.node}"
+                            f"{did_you_mean(s.node, spec.nodes)}; its samples change nothing")
+            continue
+        if s.time > end:
+            continue
+        prev = state.setdefault(node, {"alive": None, "cpu": None, "memory": None})
+        for key, value in (("alive", s.alive), ("cpu", s.cpu), ("memory", s.memory)):
+            if value is not UNSET:
+                prev[key] = value
+        data = json.dumps({"node": node, "time": s.time, **prev})
+        out.append((s.time, -1, NODE_TOPIC, _Sample(data)))
+    out.sort(key=lambda x: (x[0], x[1]))  # samples before messages of the same instant
+    return [(t, topic, msg) for t, _, topic, msg in out]
+
+
+class Resolver:
+    """Names in expectations: a behaviour's name or number, or a declared action."""
+
+    def __init__(self, spec: CheckedSpec) -> None:
+        self.spec = spec
+        self.names = {b.name: b.index for b in spec.behaviours if getattr(b, "name", "")}
+
+    def resolve(self, name: Any, path: str, line: int) -> Tuple[str, Any]:
+        """('behaviour', index) or ('action', name); TestFileError for an unknown name."""
+        n = len(self.spec.behaviours)
+        if isinstance(name, str) and name in self.names:
+            return "behaviour", self.names[name]
+        if isinstance(name, str) and name in self.spec.actions:
+            return "action", name
+        text = str(name).strip()
+        if text.startswith("behaviour "):
+            text = text[len("behaviour "):].strip()
+        if text.isdigit():
+            if 1 <= int(text) <= n:
+                return "behaviour", int(text)
+            raise TestFileError(path, line, f"there is no behaviour {text}: the spec has {n}")
+        raise TestFileError(path, line, f"'{name}' is neither a behaviour's name nor a declared action"
+                                        f"{did_you_mean(str(name), list(self.names) + list(self.spec.actions))}")
+
+    def label(self, target: Tuple[str, Any]) -> str:
+        if target[0] == "action":
+            return f"action {target[1]}"
+        b = self.spec.behaviours[target[1] - 1]
+        return b.name if getattr(b, "name", "") else f"behaviour {b.index} (line {b.span.line})"
+
+
+def timeline(spec: CheckedSpec, events: List[Event], target: Tuple[str, Any]) -> List[Tuple[str, float]]:
+    """The starts and releases of a behaviour, or of an action (first user starts, last releases)."""
+    if target[0] == "behaviour":
+        return [(e.kind, e.time) for e in events if e.kind in ("start", "release") and e.behaviour == target[1]]
+    users = {b.index for b in spec.behaviours if any(a.name == target[1] for a in b.actions)}
+    active: Set[int] = set()
+    out: List[Tuple[str, float]] = []
+    for e in events:
+        if e.behaviour not in users or e.kind not in ("start", "release"):
+            continue
+        before = bool(active)
+        (active.add if e.kind == "start" else active.discard)(e.behaviour)
+        if bool(active) != before:
+            out.append(("start" if active else "release", e.time))
+    return out
+
+
+def _intervals(tl: List[Tuple[str, float]], end: float) -> List[Tuple[float, float]]:
+    out, since = [], None
+    for kind, t in tl:
+        if kind == "start" and since is None:
+            since = t
+        elif kind == "release" and since is not None:
+            out.append((since, t))
+            since = None
+    if since is not None:
+        out.append((since, float("inf")))
+    return out
+
+
+def _fmt(tl: List[Tuple[str, float]]) -> str:
+    return ", ".join(f"{k} at {t:.3f} s" for k, t in tl) or "no start or release"
+
+
+@dataclass
+class Prepared:
+    """A test ready to run: its inputs as a recording and its expectations' targets."""
+
+    spec: CheckedSpec
+    case: Case
+    stream: List[Tuple[float, str, Any]]
+    targets: List[Tuple[Expect, Tuple[str, Any]]]
+
+
+def prepare(spec: CheckedSpec, case: Case, path: str, warnings: List[str]) -> Prepared:
+    """Check a test against its spec and build its inputs; TestFileError when they cannot be used."""
+    resolver = Resolver(spec)
+    targets = [(e, resolver.resolve(e.name, path, e.line)) for e in case.expects]
+    return Prepared(spec, case, _stream(spec, case, path, warnings), targets)
+
+
+def run_case(spec: CheckedSpec, case: Case, path: str, warnings: Optional[List[str]] = None) -> Outcome:
+    """Prepare and run one test (TestFileError when it cannot run)."""
+    return execute(prepare(spec, case, path, warnings if warnings is not None else []))
+
+
+def execute(p: Prepared) -> Outcome:
+    """Run a prepared test on the engine and check its expectations."""
+    spec, case, stream, targets = p.spec, p.case, p.stream, p.targets
+    resolver = Resolver(spec)
+    if not spec.nodes:
+        stream = [x for x in stream if x[1] != NODE_TOPIC]
+    end = case.end
+    _, events = replay(spec, stream, 0.0, end, TICK_RATE, [NODE_TOPIC] if spec.nodes else [])
+    out = Outcome(case.name, case.line, list(case.covers), duration=end)
+    out.events = [e for e in events if e.kind in ("start", "release", "rule")]
+    out.rules_true = {e.rule for e in events if e.kind == "rule" and e.value is True}
+    out.started = {e.behaviour for e in events if e.kind == "start"}
+    counted: Dict[Tuple[str, Any], List[Expect]] = {}
+    for exp, target in targets:
+        if exp.kind in ("start", "release"):
+            counted.setdefault(target, []).append(exp)
+    for target, exps in counted.items():
+        actual = timeline(spec, events, target)
+        if not _match(actual, exps, case.tolerance):
+            expected = sorted(((e.kind, e.at) for e in exps), key=lambda x: x[1])
+            out.problems.append(f"{resolver.label(target)}:\n      expected: {_fmt(expected)}\n"
+                                f"      actual:   {_fmt(actual)}")
+    for exp, target in targets:
+        tol = exp.tolerance if exp.tolerance is not None else case.tolerance
+        actual = timeline(spec, events, target)
+        if exp.kind == "never":
+            starts = [t for k, t in actual if k == "start"]
+            if starts:
+                out.problems.append(f"{resolver.label(target)}: expected never to start (line {exp.line}), "
+                                    f"but: {_fmt(actual)}")
+        elif exp.kind == "active":
+            spans = _intervals(actual, end)
+            if not any(a <= exp.start + tol and b >= exp.end - tol for a, b in spans):
+                shown = ", ".join(f"[{a:.3f}, {b:.3f}]" if b != float("inf") else f"[{a:.3f}, end]"
+                                  for a, b in spans) or "never"
+                out.problems.append(f"{resolver.label(target)}: expected active (line {exp.line}) throughout "
+                                    f"[{exp.start:.3f}, {exp.end:.3f}] s, but active: {shown}")
+    out.passed = not out.problems
+    return out
+
+
+def _match(actual: List[Tuple[str, float]], exps: List[Expect], tolerance: float) -> bool:
+    for kind in ("start", "release"):
+        times = [t for k, t in actual if k == kind]
+        wanted = sorted((e.at, e.tolerance if e.tolerance is not None else tolerance) for e in exps if e.kind == kind)
+        if len(times) != len(wanted):
+            return False
+        if any(abs(t - w) > tol + 1e-9 for t, (w, tol) in zip(sorted(times), wanted)):
+            return False
+    return True

@@ -1,0 +1,80 @@
+"""Compact series (promtool-style): `"0x10 0.6x20 0+0.1x5 _x3 nan"` -> one value or a gap per step.
+
+Words: `V` one value; `VxN` V, N times; `A+BxN` N values A, A+B, …, A+(N-1)·B (`A-BxN` counts
+down); `_` no message at that step, `_xN` N such steps. Values: numbers (a unit may follow with
+no space: `20%`, `0.5m/s`), `nan`, `inf`, `-inf`, `true`, `false`, and quoted strings.
+"""
+from __future__ import annotations
+
+import re
+from typing import Any, List
+
+from ..lang.units import parse_quantity
+
+GAP: Any = object()  # a step with no message
+
+_NUM = r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?"
+_WORD = re.compile(r'"(?:[^"\\]|\\.)*"|\'[^\']*\'|\S+')
+_RAMP = re.compile(rf"({_NUM})([-+](?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)x(\d+)")
+_REPEAT = re.compile(r"(.+)x(\d+)")
+_MAX_STEPS = 10_000_000
+
+
+class SeriesError(ValueError):
+    """A word of a series that is not one of the forms; the message says which and why."""
+
+
+def value(word: str) -> Any:
+    """One value word as a message value (float, bool or str)."""
+    low = word.lower()
+    if low in ("nan", "inf", "-inf", "+inf"):
+        return float(low)
+    if low in ("true", "false"):
+        return low == "true"
+    if len(word) >= 2 and word[0] == word[-1] and word[0] in "\"'":
+        inner = word[1:-1]
+        return re.sub(r"\\(.)", r"\1", inner) if word[0] == '"' else inner
+    q = parse_quantity(word)
+    if q is None:
+        raise SeriesError(f"'{word}' is not a value (a number, nan, inf, true, false or a quoted string)")
+    return q[0]
+
+
+def expand(text: Any) -> List[Any]:
+    """The steps of a series: values, or GAP where no message is sent."""
+    if isinstance(text, list):
+        out: List[Any] = []
+        for item in text:
+            out.extend(expand(item) if isinstance(item, str) else [item if item is not None else GAP])
+        return out
+    if isinstance(text, bool) or isinstance(text, (int, float)):
+        return [float(text) if not isinstance(text, bool) else text]
+    if not isinstance(text, str):
+        raise SeriesError("values must be a string of words or a list")
+    steps: List[Any] = []
+    for word in _WORD.findall(text):
+        steps.extend(_word(word))
+        if len(steps) > _MAX_STEPS:
+            raise SeriesError(f"more than {_MAX_STEPS} steps")
+    if not steps:
+        raise SeriesError("a series needs at least one step")
+    return steps
+
+
+def _word(word: str) -> List[Any]:
+    if word[0] in "\"'":
+        return [value(word)]
+    if word == "_":
+        return [GAP]
+    m = _RAMP.fullmatch(word)
+    if m:
+        a, b, n = float(m.group(1)), float(m.group(2)), int(m.group(3))
+        return [round(a + k * b, 12) for k in range(n)]  # 0.1 * 3 is 0.3 here, as the author meant
+    m = _REPEAT.fullmatch(word)
+    if m:
+        n = int(m.group(2))
+        if n > _MAX_STEPS:
+            raise SeriesError(f"'{word}': more than {_MAX_STEPS} steps")
+        v = GAP if m.group(1) == "_" else value(m.group(1))
+        return [v] * n
+    return [value(word)]

@@ -1,0 +1,256 @@
+"""`rubass test`: the TESTING.md contract, from files written to a temporary folder."""
+import os
+import subprocess
+import sys
+import xml.etree.ElementTree as ET
+
+import pytest
+
+from rubass.cli import main
+from rubass.testing.series import GAP, SeriesError, expand
+
+from conftest import ROOT
+
+LIB = """actions:
+  stop: {plugin: log, level: warn}
+  warn: {plugin: log, level: warn}
+"""
+
+SPEC = """import "lib.yaml";
+action primitive stop, warn;
+entity base: controller {
+  rules:
+    too_fast: topic /odom.twist.twist.linear.x > 0.5 m/s for 1 s;
+    close: topic /scan.range_min > 0.5 m;
+    hot: cpu(node controller) > 90 %;
+    silent: age(topic /cmd_vel) > 0.5 s;
+}
+overspeed: if (base.too_fast) then { stop; }
+obstacle: if (base.close) then { stop; warn; }
+if (base.hot) then { warn; }
+if (base.silent) then { warn; }
+"""
+
+ODOM = """      /odom:
+        type: nav_msgs/Odometry
+        rate: 10 Hz
+        field: twist.twist.linear.x
+        values: "0x10 0.6x20 0x10"
+"""
+
+
+@pytest.fixture
+def files(write):
+    write("lib.yaml", LIB)
+    write("robot.rbs", SPEC)
+
+    def make(tests, name="robot.test.yaml"):
+        return write(name, "spec: robot.rbs\ntests:\n" + tests)
+
+    return make
+
+
+def run(capsys, *args):
+    code = main(["test", *args])
+    out, err = capsys.readouterr()
+    return code, out, err
+
+
+def test_series_words():
+    assert expand("0x2 1+0.5x3 1-0.1x2 _ _x2 nan true 'a b' 20%") [:7] == [0.0, 0.0, 1.0, 1.5, 2.0, 1.0, 0.9]
+    steps = expand("_ _x2 nan true 'a b' 20% -inf")
+    assert steps[:3] == [GAP] * 3 and steps[3] != steps[3] and steps[4:] == [True, "a b", 0.2, float("-inf")]
+    assert expand("0+0.1x4")[3] == 0.3  # what the author meant, not 0.30000000000000004
+    with pytest.raises(SeriesError):
+        expand("0x3 abc")
+
+
+def test_passing_file_prints_each_test_and_the_count(files, capsys):
+    path = files("""  - name: overspeed stops after one second
+    covers: [SR-1]
+    topics:
+""" + ODOM + """    expect:
+      - {at: 2 s, start: overspeed}
+      - {at: 3 s, release: overspeed}
+      - {active: stop, from: 2.1 s, to: 2.9 s}
+      - {never: obstacle}
+""")
+    code, out, err = run(capsys, path)
+    assert code == 0, out + err
+    assert "PASS  overspeed stops after one second" in out
+    assert out.strip().splitlines()[-1] == "1 passed, 0 failed"
+
+
+def test_failure_shows_expected_and_actual_and_exits_1(files, capsys):
+    path = files("""  - name: wrong time
+    topics:
+""" + ODOM + """    expect:
+      - {at: 2.5 s, start: overspeed}
+      - {at: 3 s, release: overspeed}
+""")
+    code, out, _ = run(capsys, path)
+    assert code == 1
+    assert "FAIL  wrong time" in out
+    assert "expected: start at 2.500 s, release at 3.000 s" in out
+    assert "actual:   start at 2.000 s, release at 3.000 s" in out
+    assert out.strip().splitlines()[-1] == "0 passed, 1 failed"
+
+
+def test_tolerance_default_1ms_and_per_test(files, capsys):
+    tmpl = """  - name: t
+    {tol}
+    topics:
+""" + ODOM + """    expect:
+      - {{at: {at}, start: overspeed}}
+      - {{at: 3 s, release: overspeed}}
+"""
+    assert run(capsys, files(tmpl.format(tol="", at="2.0009 s")))[0] == 0
+    assert run(capsys, files(tmpl.format(tol="", at="2.002 s")))[0] == 1
+    assert run(capsys, files(tmpl.format(tol="tolerance: 5 ms", at="2.004 s")))[0] == 0
+
+
+def test_every_event_of_a_mentioned_name_must_be_listed(files, capsys):
+    # a release that is not listed fails the test; an unmentioned behaviour is free
+    path = files("""  - name: t
+    topics:
+""" + ODOM + """    expect:
+      - {at: 2 s, start: overspeed}
+""")
+    code, out, _ = run(capsys, path)
+    assert code == 1 and "actual:   start at 2.000 s, release at 3.000 s" in out
+
+
+def test_actions_start_with_the_first_user_and_release_with_the_last(files, capsys):
+    path = files("""  - name: stop spans both behaviours
+    topics:
+""" + ODOM + """      /scan:
+        type: sensor_msgs/LaserScan
+        messages:
+          - {at: 1.5 s, range_min: 1.0}
+          - {at: 2.5 s, range_min: 0.0}
+    expect:
+      - {at: 1.5 s, start: stop}
+      - {at: 3 s, release: stop}
+      - {at: 1.5 s, start: 2}
+      - {at: 2.5 s, release: behaviour 2}
+""")
+    code, out, err = run(capsys, path)
+    assert code == 0, out + err
+
+
+def test_node_samples_keep_left_out_values(files, capsys):
+    path = files("""  - name: hot controller
+    duration: 4 s
+    nodes:
+      controller:
+        - {at: 0 s, alive: true, cpu: 20 %, memory: 50 MB}
+        - {at: 1 s, cpu: 95 %}
+        - {at: 2 s, memory: 60 MB}
+        - {at: 3 s, cpu: 0.5}
+    topics:
+      /cmd_vel: {type: geometry_msgs/Twist, rate: 10 Hz, field: linear.x, values: "0x50"}
+    expect:
+      - {at: 1 s, start: 3}
+      - {at: 3 s, release: 3}
+      - {never: 4}
+""")
+    code, out, err = run(capsys, path)
+    assert code == 0, out + err
+
+
+def test_silence_and_duration(files, capsys):
+    path = files("""  - name: silent cmd_vel
+    duration: 3 s
+    topics:
+      /cmd_vel: {type: geometry_msgs/Twist, rate: 10 Hz, field: linear.x, values: "0x10 _x10 0x10"}
+    expect:
+      - {at: 1.4 s, start: 4}
+      - {at: 2.0 s, release: 4}
+      - {active: 4, from: 1.5 s, to: 1.95 s}
+""")
+    code, out, err = run(capsys, path)
+    assert code == 0, out + err
+
+
+def test_same_instant_is_one_message_later_entries_win(files, capsys):
+    path = files("""  - name: merged
+    topics:
+      /scan:
+        type: sensor_msgs/LaserScan
+        rate: 1 Hz
+        fields: {range_min: "1 1", range_max: "5 5"}
+        messages:
+          - {at: 1 s, range_min: 0.0}
+    expect:
+      - {at: 0 s, start: obstacle}
+      - {at: 1 s, release: obstacle}
+""")
+    code, out, err = run(capsys, path)
+    assert code == 0, out + err
+
+
+def test_header_stamp_is_the_message_time_unless_set():
+    from rubass.testing.messages import build, message_class
+
+    cls = message_class("nav_msgs/Odometry")
+    assert build(cls, [], 1.25).header.stamp.to_sec() == 1.25
+    assert build(cls, [(("header",), {"stamp": 0})], 1.25).header.stamp.is_zero()
+
+
+@pytest.mark.parametrize("body,line,text", [
+    ("  - name: x\n    expect: [{at: 1 s, start: nobody}]\n", 4, "'nobody' is neither a behaviour's name"),
+    ("  - name: x\n    expectt: []\n", 4, "unknown key 'expectt'"),
+    ("  - name: x\n    topics:\n      /odom: {type: nav_msgs/Odometry, rate: 10 Hz, field: twist.linear.x, values: '1'}\n"
+     "    expect: []\n", 5, "has no field 'linear'"),
+    ("  - name: x\n    topics:\n      /odom: {type: nav_msgs/Odometri, messages: [{at: 1 s}]}\n    expect: []\n", 5,
+     "nav_msgs/Odometri is not installed"),
+    ("  - name: x\n    topics:\n      /odom:\n        type: nav_msgs/Odometry\n        messages:\n"
+     "          - {at: 1 s, child_frame_id: 3}\n    expect: []\n", 8, "is a string"),
+    ("  - name: x\n    expect: [{at: 1 parsec, start: 1}]\n", 4, "not a quantity in seconds"),
+    ("  - name: x\n    expect: [{start: 1}]\n", 4, "start needs 'at'"),
+    ("  - name: x\n    expect:\n      - {at: 1 s, start: 1\n", 6, "not valid YAML"),
+    ("  - name: x\n    topics:\n      /odom: {type: nav_msgs/Odometry, rate: 10 Hz, field: twist.twist.linear.x, "
+     "values: '1x3 zz'}\n    expect: []\n", 5, "'zz' is not a value"),
+])
+def test_bad_files_say_file_line_error_and_exit_2(files, capsys, body, line, text):
+    path = files(body)
+    code, out, err = run(capsys, path)
+    assert code == 2
+    assert f"{path}:{line}: error: " in err and text in err, err
+    assert "Traceback" not in out + err
+
+
+def test_bad_spec_is_reported_with_the_spec_error(files, write, capsys):
+    write("robot.rbs", SPEC.replace("base.hot", "base.hott"))
+    code, _, err = run(capsys, files("  - name: x\n    expect: []\n"))
+    assert code == 2 and "robot.test.yaml:1: error: spec" in err and "has no rule 'hott'" in err
+
+
+def test_junit_and_coverage(files, tmp_path, capsys):
+    path = files("""  - name: good
+    covers: [SR-1]
+    topics:
+""" + ODOM + """    expect:
+      - {at: 2 s, start: overspeed}
+      - {at: 3 s, release: overspeed}
+  - name: bad
+    expect:
+      - {at: 1 s, start: obstacle}
+""")
+    out_xml = str(tmp_path / "out.xml")
+    code, out, _ = run(capsys, path, "--junit", out_xml, "--coverage")
+    assert code == 1
+    suite = ET.parse(out_xml).getroot().find("testsuite")
+    cases = suite.findall("testcase")
+    assert [c.get("name") for c in cases] == ["good", "bad"]
+    assert cases[0].find("failure") is None and cases[1].find("failure") is not None
+    assert suite.get("failures") == "1"
+    assert "rules never true: base.close, base.hot" in out
+    assert "behaviours never started: obstacle, behaviour 3 (line 12)" in out
+
+
+def test_command_line_exit_codes():
+    r = subprocess.run([sys.executable, "-m", "rubass", "test", "/nonexistent.test.yaml"], cwd=ROOT,
+                       capture_output=True, text=True)
+    assert r.returncode == 2 and "/nonexistent.test.yaml: error: cannot read" in r.stderr
+    assert r.stdout.strip().endswith("0 passed, 0 failed")
