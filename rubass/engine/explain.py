@@ -52,6 +52,7 @@ class Witness:
     rules: Tuple[str, ...]
     readings: Tuple[Reading, ...]
     attrs: Tuple[Tuple[str, Tuple[str, ...]], ...] = ()
+    name: str = ""  # the behaviour's name (§14), "" when unnamed
 
     def values(self) -> Dict[str, Any]:
         """term -> value (None when unknown), as JSON shows them."""
@@ -61,8 +62,10 @@ class Witness:
         return {r.term: r.unit for r in self.readings if r.unit}
 
     def as_json(self) -> Dict[str, Any]:
-        return {"rules": list(self.rules), "witnesses": self.values(), "units": self.units(),
-                "attrs": {k: list(v) for k, v in self.attrs}}
+        out: Dict[str, Any] = {"name": self.name} if self.name else {}
+        out.update({"rules": list(self.rules), "witnesses": self.values(), "units": self.units(),
+                    "attrs": {k: list(v) for k, v in self.attrs}})
+        return out
 
 
 def label(e: ast.Expr) -> Optional[str]:
@@ -126,7 +129,7 @@ class Explainer:
                 if value is not _ARRAY:
                     readings.append(Reading(term, value, unit))
         attrs = tuple(sorted((k, tuple(v)) for k, v in (getattr(b, "attrs", None) or {}).items()))
-        return Witness(tuple(true_rules), tuple(readings), attrs)
+        return Witness(tuple(true_rules), tuple(readings), attrs, getattr(b, "name", "") or "")
 
     def _true_rules(self, cond: ast.Expr) -> List[str]:
         out: List[str] = []

@@ -67,6 +67,11 @@ def json_lines(events: List[Event], out: TextIO) -> None:
         if e.kind in ("start", "release"):
             obj: Dict[str, Any] = {"time": e.time, "event": e.kind, "behaviour": e.behaviour, "line": e.line,
                                    "actions": list(e.actions)}
+            if getattr(e, "name", ""):
+                obj["name"] = e.name
+            witness = getattr(e, "witness", None)
+            if witness is not None:  # why it started: true rules, the values they read (docs/replay.md)
+                obj.update(witness.as_json())
         elif e.kind == "rule":
             obj = {"time": e.time, "event": "rule", "rule": e.rule, "value": e.value}
         else:
@@ -78,7 +83,17 @@ def human(spec: CheckedSpec, events: List[Event], end: float, out: TextIO) -> No
     """Each start and release, then a summary per rule and per behaviour."""
     for e in events:
         if e.kind == "start":
-            out.write(f"{e.time:10.3f} s  start    behaviour {e.behaviour} (line {e.line}): {', '.join(e.actions)}\n")
+            witness = getattr(e, "witness", None)
+            name = getattr(e, "name", "") or (witness.name if witness is not None else "")
+            name = f" {name}" if name else ""
+            out.write(f"{e.time:10.3f} s  start    behaviour {e.behaviour}{name} (line {e.line}): {', '.join(e.actions)}\n")
+            if witness is not None:
+                for label, values in sorted(witness.attrs):
+                    out.write(f"{'':14}@{label}: {', '.join(values)}\n")
+                if witness.rules:
+                    out.write(f"{'':14}true: {', '.join(witness.rules)}\n")
+                for reading in witness.readings:
+                    out.write(f"{'':14}{reading.text()}\n")
         elif e.kind == "release":
             out.write(f"{e.time:10.3f} s  release  behaviour {e.behaviour} (line {e.line})\n")
     rules, behaviours = summarise(spec, events, end)

@@ -73,11 +73,15 @@ class Dispatcher:
         if e.kind == "start" and latency is not None:
             self.latencies.append(latency)
             del self.latencies[:-1000]
-        self.report({
+        record: Dict[str, Any] = {
             "time": e.time, "event": e.kind, "behaviour": e.behaviour, "line": b.span.line,
             "actions": [a.name for a in b.actions], "rules": list(rules), "cause": source,
             "latency_ms": None if latency is None else round(latency * 1000.0, 3),
-        })
+        }
+        witness = getattr(e, "witness", None)
+        if witness is not None:  # why it started: name, attributes, true rules and the values they read
+            record.update(witness.as_json())
+        self.report(record)
 
     def release(self, b: CheckedBehaviour, key: Any, now: float) -> None:
         """Release a behaviour's actions outside an engine event (reload, reset, shutdown)."""

@@ -100,3 +100,20 @@ def test_explain_is_cheap_at_the_transition():
     for _ in range(200):
         e.explain(1)
     assert (time.perf_counter() - t0) / 200 < 0.005  # generous on a loaded machine
+
+
+def test_replay_json_and_report_show_witnesses():
+    import io
+
+    from rubass.replay import report
+
+    e = engine()
+    events = e.on_message("/odom", 0.3, odom(0.62))
+    out = io.StringIO()
+    report.json_lines(events, out)
+    (line,) = [json.loads(x) for x in out.getvalue().splitlines() if '"start"' in x]
+    assert line["witnesses"] == {"/odom.twist.twist.linear.x": 0.62} and line["rules"] == ["base.too_fast"]
+    text = io.StringIO()
+    report.human(e.spec, events, 1.0, text)
+    assert "true: base.too_fast" in text.getvalue()
+    assert "/odom.twist.twist.linear.x = 0.62" in text.getvalue()
