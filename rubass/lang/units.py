@@ -3,7 +3,8 @@ from __future__ import annotations
 
 from typing import Dict, Optional, Tuple
 
-# A dimension is a sorted tuple of (base, exponent); bases: m, s, rad, B.
+# A dimension is a sorted tuple of (base, exponent); bases: m, s, rad, B, and V (voltage),
+# A (current), degC (temperature), Pa (pressure), geo_deg (latitude/longitude, see GEO_DEGREE).
 Dimension = Tuple[Tuple[str, int], ...]
 
 DIMENSIONLESS: Dimension = ()
@@ -34,6 +35,13 @@ LENGTH = dim(m=1)
 SPEED = dim(m=1, s=-1)
 FREQUENCY = dim(s=-1)
 MEMORY = dim(B=1)
+VOLTAGE = dim(V=1)
+CURRENT = dim(A=1)
+TEMPERATURE = dim(degC=1)  # Celsius only: no kelvin, so no offset to convert
+PRESSURE = dim(Pa=1)
+# NavSatFix latitude and longitude are degrees, not SI radians: a dimension of their own, so that
+# `topic /fix.latitude > 45 deg` (45 deg is 0.785 rad) is an error rather than a silent mismatch.
+GEO_DEGREE = dim(geo_deg=1)
 
 _NAMES = {
     (): "share",
@@ -45,6 +53,14 @@ _NAMES = {
     dim(rad=1, s=-1): "angular speed",
     FREQUENCY: "frequency",
     MEMORY: "memory",
+    VOLTAGE: "voltage",
+    CURRENT: "current",
+    TEMPERATURE: "temperature",
+    PRESSURE: "pressure",
+    dim(V=1, A=1): "power",
+    GEO_DEGREE: "latitude/longitude in degrees (compare with a bare number)",
+    dim(m=2): "area",
+    dim(rad=1, s=-2): "angular acceleration",
 }
 
 # unit -> (factor to SI, dimension)
@@ -60,6 +76,11 @@ UNITS: Dict[str, Tuple[float, Dimension]] = {
     "%": (1e-2, DIMENSIONLESS),
     "B": (1.0, MEMORY), "kB": (1e3, MEMORY), "MB": (1e6, MEMORY), "GB": (1e9, MEMORY),
     "KiB": (1024.0, MEMORY), "MiB": (1024.0 ** 2, MEMORY), "GiB": (1024.0 ** 3, MEMORY),
+    "V": (1.0, VOLTAGE), "mV": (1e-3, VOLTAGE),
+    "A": (1.0, CURRENT), "mA": (1e-3, CURRENT),
+    "degC": (1.0, TEMPERATURE), "\u00b0C": (1.0, TEMPERATURE),  # '°C' only in YAML: a spec writes degC
+    "Pa": (1.0, PRESSURE), "hPa": (1e2, PRESSURE), "kPa": (1e3, PRESSURE),
+    "rad/s^2": (1.0, dim(rad=1, s=-2)),
 }
 
 

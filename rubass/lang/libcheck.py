@@ -1,0 +1,198 @@
+"""Action libraries checked against message and service definitions: every publish type and
+service type exists, and every field of `message:`, `on_release:` and `request:` exists with a
+value of a fitting type. Errors point at the YAML file and line."""
+from __future__ import annotations
+
+from typing import Any, Dict, List, Optional, Tuple
+
+import yaml
+
+from .errors import Diagnostic, did_you_mean
+from .library import ActionDef
+from .msgdef import INTEGERS, FieldDef, MsgSpec, Registry
+from .source import SourceSet, Span
+
+_FLOATS = ("float32", "float64")
+
+
+def _span(node: yaml.Node, file: str) -> Span:
+    m = node.start_mark
+    return Span(file, m.line + 1, m.column + 1, m.index, node.end_mark.index)
+
+
+def _entries(node: Optional[yaml.Node]) -> Dict[str, Tuple[yaml.Node, yaml.Node]]:
+    if not isinstance(node, yaml.MappingNode):
+        return {}
+    return {str(k.value): (k, v) for k, v in node.value if isinstance(k, yaml.ScalarNode)}
+
+
+def _action_nodes(sources: SourceSet, act: ActionDef) -> Dict[str, Tuple[yaml.Node, yaml.Node]]:
+    """The YAML key/value nodes of one action's definition ({} when the text is not at hand)."""
+    src = sources.get(act.span.file)
+    if src is None:
+        return {}
+    try:
+        root = yaml.compose(src.text, Loader=yaml.SafeLoader)
+    except (yaml.YAMLError, ValueError, RecursionError):
+        return {}
+    actions = _entries(root).get("actions")
+    entry = _entries(actions[1] if actions else None).get(act.name)
+    return _entries(entry[1] if entry else None)
+
+
+class _FieldChecker:
+    def __init__(self, registry: Registry, file: str, action: str) -> None:
+        self.registry, self.file, self.action = registry, file, action
+        self.diags: List[Diagnostic] = []
+
+    def error(self, node: yaml.Node, msg: str) -> None:
+        self.diags.append(Diagnostic(_span(node, self.file), f"action '{self.action}': {msg}"))
+
+    def message(self, spec: MsgSpec, node: yaml.Node, where: str) -> None:
+        if isinstance(node, yaml.ScalarNode) and node.tag.endswith(":null"):
+            return
+        if isinstance(node, yaml.SequenceNode):  # genpy fills a message from positional values too
+            if len(node.value) != len(spec.fields):
+                self.error(node, f"'{where}' lists {len(node.value)} values, {spec.type} has {len(spec.fields)} "
+                                 f"fields ({', '.join(spec.names)})")
+                return
+            for f, v in zip(spec.fields, node.value):
+                self.field(f, v, f"{where}.{f.name}")
+            return
+        if not isinstance(node, yaml.MappingNode):
+            self.error(node, f"'{where}' must be a mapping of {spec.type} fields ({', '.join(spec.names)})")
+            return
+        for key, (knode, vnode) in _entries(node).items():
+            f = spec.get(key)
+            path = f"{where}.{key}"
+            if f is None:
+                self.error(knode, f"{spec.type} has no field '{key}'{did_you_mean(key, spec.names)} "
+                                  f"(its fields: {', '.join(spec.names) or 'none'})")
+                continue
+            self.field(f, vnode, path)
+
+    def field(self, f: FieldDef, node: yaml.Node, where: str) -> None:
+        if f.is_array:
+            if f.type in ("uint8", "char") and isinstance(node, yaml.ScalarNode) and node.tag.endswith(":str"):
+                return  # bytes given as a string
+            if not isinstance(node, yaml.SequenceNode):
+                self.error(node, f"'{where}' is an array ({f.type}[]): give a list, got {_show(node)}")
+                return
+            if f.length is not None and len(node.value) != f.length:
+                self.error(node, f"'{where}' is a {f.type}[{f.length}]: give exactly {f.length} values, "
+                                 f"got {len(node.value)}")
+            for i, v in enumerate(node.value):
+                self.field(FieldDef(f.name, f.type), v, f"{where}[{i}]")
+            return
+        if not f.is_primitive:
+            spec = self.registry.get(f.type)
+            if spec is not None:
+                self.message(spec, node, where)
+            return
+        if f.type in ("time", "duration") and isinstance(node, yaml.MappingNode):
+            for key, (knode, vnode) in _entries(node).items():
+                if key not in ("secs", "nsecs"):
+                    self.error(knode, f"'{where}' is a {f.type}: its fields are secs and nsecs, not '{key}'")
+                elif _primitive_problem("int32", _scalar(vnode)):
+                    self.error(vnode, f"'{where}.{key}' must be a whole number, got {_show(vnode)}")
+            return
+        value = _scalar(node)
+        problem = _primitive_problem(f.type, value)
+        if problem:
+            self.error(node, f"'{where}' is a {f.type}: {problem}, got {_show(node)}")
+
+
+_NOT_SCALAR = object()
+
+
+def _scalar(node: yaml.Node) -> Any:
+    if not isinstance(node, yaml.ScalarNode):
+        return _NOT_SCALAR
+    return yaml.SafeLoader("").construct_object(node, deep=True)
+
+
+def _show(node: yaml.Node) -> str:
+    if isinstance(node, yaml.MappingNode):
+        return "a mapping"
+    if isinstance(node, yaml.SequenceNode):
+        return "a list"
+    return repr(_scalar(node))
+
+
+def _primitive_problem(ftype: str, v: Any) -> Optional[str]:
+    if ftype in ("time", "duration"):
+        return None if isinstance(v, int) and not isinstance(v, bool) else \
+            "give {secs: S, nsecs: N} or a whole number of nanoseconds"
+    if ftype == "bool":
+        return None if isinstance(v, bool) else "give true or false"
+    if ftype == "string":
+        return None if isinstance(v, str) else "give a string (quote it)"
+    if ftype in _FLOATS:
+        return None if isinstance(v, (int, float)) and not isinstance(v, bool) else "give a number"
+    lo, hi = INTEGERS[ftype]
+    if isinstance(v, bool) or not isinstance(v, int):
+        return f"give a whole number from {lo} to {hi}"
+    return None if lo <= v <= hi else f"the value must be from {lo} to {hi}"
+
+
+def check_library_types(actions: Dict[str, ActionDef], sources: SourceSet, registry: Registry,
+                        looked_in: str = "installed packages") -> List[Diagnostic]:
+    """Errors for publish and service actions whose types or fields do not fit the definitions.
+
+    `looked_in` says where types were looked for, for the message of an unknown type."""
+    diags: List[Diagnostic] = []
+    for act in sorted(actions.values(), key=lambda a: (a.span.file, a.span.line)):
+        if act.plugin not in ("publish", "service"):
+            continue
+        nodes = _action_nodes(sources, act)
+        tnode = nodes.get("type", (None, None))[1]
+        type_span = _span(tnode, act.span.file) if tnode is not None else act.span
+        c = _FieldChecker(registry, act.span.file, act.name)
+        type_name = str(act.params.get("type"))
+        if act.plugin == "publish":
+            spec = registry.get(type_name)
+            if spec is None:
+                diags.append(Diagnostic(type_span, f"action '{act.name}': unknown message type '{type_name}' "
+                                                   f"(not in {looked_in}){did_you_mean(type_name, registry.types)}"))
+                continue
+            for key in ("message", "on_release"):
+                if key in nodes:
+                    c.message(spec, nodes[key][1], key)
+        else:
+            srv = registry.services.get(type_name)
+            if srv is None:
+                diags.append(Diagnostic(type_span, f"action '{act.name}': unknown service type '{type_name}' "
+                                                   f"(not in {looked_in}){did_you_mean(type_name, registry.services)}"))
+                continue
+            if "request" in nodes:
+                c.message(srv[0], nodes["request"][1], "request")
+        diags.extend(c.diags)
+    return diags
+
+
+def library_types(actions: Dict[str, ActionDef]) -> Tuple[List[str], List[str]]:
+    """(message types, service types) the publish and service actions name."""
+    msgs = sorted({str(a.params.get("type")) for a in actions.values() if a.plugin == "publish"})
+    srvs = sorted({str(a.params.get("type")) for a in actions.values() if a.plugin == "service"})
+    return msgs, srvs
+
+
+def check_publish_topics(actions: Dict[str, ActionDef], sources: SourceSet, topics: Dict[str, str],
+                         source: str) -> List[Diagnostic]:
+    """Errors for publish actions whose topic carries another type in the system model: the
+    robot's subscribers would refuse the connection and the message would never arrive."""
+    diags: List[Diagnostic] = []
+    for act in sorted(actions.values(), key=lambda a: (a.span.file, a.span.line)):
+        if act.plugin != "publish":
+            continue
+        if str(act.params.get("topic", "")).startswith("~"):
+            continue  # private to the monitor: resolved under its own name
+        topic = "/" + str(act.params.get("topic", "")).strip("/")
+        have, want = topics.get(topic), str(act.params.get("type"))
+        if have is None or have == want:
+            continue
+        node = _action_nodes(sources, act).get("type", (None, None))[1]
+        span = _span(node, act.span.file) if node is not None else act.span
+        diags.append(Diagnostic(span, f"action '{act.name}': publishes {want} on {topic}, which carries {have} in "
+                                      f"{source}: its subscribers would refuse the connection"))
+    return diags

@@ -1,0 +1,128 @@
+"""A system model of a robot: its topics and their types, its nodes, message definitions and
+units; the FieldModel the checker asks, and the warnings for topics and nodes it lacks."""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Dict, Iterator, List, Optional, Tuple
+
+from . import ast
+from .errors import Diagnostic, did_you_mean
+from .fieldmodel import FieldInfo
+from .msgdef import Registry
+from .msgpath import UnitTable, has_stamp, resolve
+from .std_units import STANDARD_UNITS
+from .units import Dimension
+
+
+def norm_topic(name: str) -> str:
+    """'/cmd_vel' for 'cmd_vel', '/cmd_vel/' or '//cmd_vel'."""
+    return "/" + name.strip("/").replace("//", "/")
+
+
+@dataclass
+class SystemModel:
+    """What the checker may know of a robot before it runs.
+
+    topics: topic -> message type ('package/Type'); nodes: the node names, or None when the
+    source does not say (then no node is reported missing); units: per message type, dotted
+    field path -> dimension (custom messages); topic_units: the same per topic (e.g. a
+    JointState whose joints all rotate); source: how messages name it ('recording run.bag').
+    """
+
+    topics: Dict[str, str]
+    nodes: Optional[List[str]] = None
+    registry: Registry = field(default_factory=Registry)
+    units: UnitTable = field(default_factory=dict)
+    topic_units: Dict[str, Dict[str, Dimension]] = field(default_factory=dict)
+    source: str = "the system model"
+
+    def __post_init__(self) -> None:
+        self.topics = {norm_topic(t): ty for t, ty in self.topics.items()}
+        self.topic_units = {norm_topic(t): u for t, u in self.topic_units.items()}
+        if self.nodes is not None:
+            self.nodes = sorted({norm_topic(n) for n in self.nodes})
+
+    # -- the FieldModel protocol ------------------------------------------------------------
+    def field(self, topic: str, path: Tuple[ast.PathElem, ...]) -> Optional[FieldInfo]:
+        type_name = self.topics.get(norm_topic(topic))
+        if type_name is None:
+            return None
+        return resolve(self.registry, type_name, path, (STANDARD_UNITS, self.units),
+                       self.topic_units.get(norm_topic(topic)))
+
+    def has_stamp(self, topic: str) -> Optional[bool]:
+        type_name = self.topics.get(norm_topic(topic))
+        return None if type_name is None else has_stamp(self.registry, type_name)
+
+    # -- helpers --------------------------------------------------------------------------
+    def type_of(self, topic: str) -> Optional[str]:
+        return self.topics.get(norm_topic(topic))
+
+    def undefined_types(self) -> List[str]:
+        """Topic types (and types they use) with no definition in the model."""
+        missing = set()
+        todo = list(self.topics.values())
+        seen = set()
+        while todo:
+            t = todo.pop()
+            if t in seen:
+                continue
+            seen.add(t)
+            spec = self.registry.get(t)
+            if spec is None:
+                missing.add(t)
+            else:
+                todo += [f.type for f in spec.fields if not f.is_primitive]
+        return sorted(missing)
+
+
+def _topic_refs(spec: ast.Spec) -> Iterator[ast.TopicRef]:
+    for e in _exprs(spec):
+        for sub in ast.walk(e):
+            if isinstance(sub, ast.TopicRef):
+                yield sub
+
+
+def _exprs(spec: ast.Spec) -> Iterator[ast.Expr]:
+    for d in spec.decls:
+        if isinstance(d, ast.Entity):
+            yield from (r.expr for r in d.rules)
+        elif isinstance(d, ast.Behaviour):
+            yield d.cond
+
+
+def graph_warnings(spec: ast.Spec, model: SystemModel) -> List[Diagnostic]:
+    """A warning at the first use of each topic the model lacks and each node it does not list,
+    with a did-you-mean from the model's names. Relative names are taken from the root."""
+    out: List[Diagnostic] = []
+    seen = set()
+    for ref in sorted(_topic_refs(spec), key=lambda r: (r.span.line, r.span.col)):
+        name = norm_topic(ref.topic)
+        if name in seen or name in model.topics:
+            continue
+        seen.add(name)
+        out.append(Diagnostic(ref.span, f"topic '{ref.topic}' is not in {model.source}"
+                                        f"{did_you_mean(name, model.topics)}", "warning"))
+    if model.nodes is None:
+        return out
+    out += _node_warnings(spec, model, model.nodes)
+    return sorted(out, key=lambda d: (d.span.line, d.span.col))
+
+
+def _node_warnings(spec: ast.Spec, model: SystemModel, known: List[str]) -> List[Diagnostic]:
+    out: List[Diagnostic] = []
+    nodes: List[Tuple[str, ast.Ident]] = []
+    seen_nodes = set()
+    for d in spec.decls:
+        if isinstance(d, ast.Entity):
+            nodes += [(n.name, n) for n in d.nodes]
+    for e in _exprs(spec):
+        nodes += [(sub.node, ast.Ident(sub.node, sub.span)) for sub in ast.walk(e) if isinstance(sub, ast.NodeRef)]
+    for name, ident in sorted(nodes, key=lambda p: (p[1].span.line, p[1].span.col)):
+        key = norm_topic(name)
+        if key in seen_nodes or key in known:
+            continue
+        seen_nodes.add(key)
+        out.append(Diagnostic(ident.span, f"node '{name}' is not in {model.source}"
+                                          f"{did_you_mean(key, known)}", "warning"))
+    return out

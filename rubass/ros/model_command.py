@@ -1,0 +1,121 @@
+"""`rubass model` (write a system model from a recording or the live graph) and the system-model
+options of `rubass check` (--bag, --live, --model): building the model, and the checks that run
+after the spec's own (topics and nodes the model lacks, action libraries against definitions)."""
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+from typing import List, Optional, Tuple
+
+from ..lang.errors import Diagnostic
+from ..lang.libcheck import check_library_types, check_publish_topics, library_types
+from ..lang.model import CheckedSpec
+from ..lang.modelfile import dump_model, load_model
+from ..lang.msgdef import Registry
+from ..lang.source import SourceSet
+from ..lang.sysmodel import SystemModel, graph_warnings
+from .bag import BagError
+from .model_sources import LiveError, add_installed, bag_model, live_model
+
+
+def add_source_options(parser: argparse.ArgumentParser, for_check: bool) -> None:
+    """--bag / --live / --model (check only) / --master, one source at a time."""
+    g = parser.add_mutually_exclusive_group(required=not for_check)
+    g.add_argument("--bag", metavar="RUN.bag", help="a recording: its topics, types and message definitions")
+    g.add_argument("--live", action="store_true", help="the running ROS graph (ROS_MASTER_URI or --master)")
+    if for_check:
+        g.add_argument("--model", metavar="ROBOT.yaml", help="a system model file written by 'rubass model'")
+    parser.add_argument("--master", metavar="URI", help="the master for --live (default: ROS_MASTER_URI)")
+
+
+def build_model(args: argparse.Namespace) -> Tuple[Optional[SystemModel], int]:
+    """The model the options name (None when none), or an exit status when it cannot be had;
+    problems are printed."""
+    try:
+        if getattr(args, "bag", None):
+            return bag_model(args.bag), 0
+        if getattr(args, "live", False):
+            return live_model(args.master), 0
+    except (BagError, LiveError) as exc:
+        print(f"rubass: error: {exc}", file=sys.stderr)
+        return None, 2
+    path = getattr(args, "model", None)
+    if not path:
+        return None, 0
+    sources = SourceSet()
+    model, diags = load_model(path, sources)
+    if model is None:
+        for d in diags:
+            print(d.render(sources), file=sys.stderr)
+        n = len(diags)
+        print(f"{path}: {n} error{'s' if n != 1 else ''}", file=sys.stderr)
+        return None, 1
+    undefined = model.undefined_types()
+    if undefined:  # a hand-written model: what is installed here fills the gaps
+        _try_installed(model.registry, undefined, ())
+    return model, 0
+
+
+def _try_installed(registry: Registry, msgs: List[str], srvs: List[str]) -> bool:
+    try:
+        add_installed(registry, msgs, srvs)
+        return True
+    except ImportError:  # no ROS Python here: only the model's own definitions
+        return False
+
+
+def after_check(checked: CheckedSpec, model: Optional[SystemModel]) -> Tuple[List[Diagnostic], List[Diagnostic]]:
+    """(errors, warnings) of the checks against the system: the spec's topics and nodes the
+    model lacks (warnings), and its action libraries against message definitions (errors)."""
+    warnings = graph_warnings(checked.spec, model) if model is not None else []
+    registry = Registry()
+    if model is not None:
+        for spec in model.registry.types.values():
+            registry.add(spec)
+    msgs, srvs = library_types(checked.actions)
+    installed = _try_installed(registry, msgs, srvs)
+    if not installed and model is None:
+        return [], warnings  # nothing to check against
+    where = " or ".join(([model.source] if model is not None else []) +
+                        (["the message packages installed here"] if installed else []))
+    errors = check_library_types(checked.actions, checked.sources, registry, where)
+    if model is not None:
+        errors += check_publish_topics(checked.actions, checked.sources, model.topics, model.source)
+    return errors, warnings
+
+
+def cmd_model(args: argparse.Namespace) -> int:
+    """Write the system model of a recording or of the live graph."""
+    model, status = build_model(args)
+    if model is None:
+        return status or 2
+    origin = f"recording {os.path.basename(args.bag)}" if args.bag else f"live graph ({model.source.split(' at ')[-1]})"
+    text = dump_model(model, origin)
+    if args.output in (None, "-"):
+        sys.stdout.write(text)
+    else:
+        tmp = args.output + ".rubass-model.tmp"
+        try:
+            with open(tmp, "w", encoding="utf-8") as fh:
+                fh.write(text)
+            os.replace(tmp, args.output)
+        except OSError as exc:
+            print(f"rubass: error: cannot write {args.output}: {exc.strerror or exc}", file=sys.stderr)
+            return 1
+        print(f"{args.output}: {len(model.topics)} topics, "
+              f"{'no node list' if model.nodes is None else f'{len(model.nodes)} nodes'}, "
+              f"{len(model.registry.closure(model.topics.values()))} message types", file=sys.stderr)
+    missing = model.undefined_types()
+    if missing:
+        print(f"rubass: warning: no definition found for {', '.join(missing)}: their fields cannot be checked",
+              file=sys.stderr)
+    return 0
+
+
+def register(sub: "argparse._SubParsersAction") -> None:
+    """Add `rubass model` to the command line."""
+    m = sub.add_parser("model", help="write a system model (topics, types, nodes) from a recording or the live graph")
+    add_source_options(m, for_check=False)
+    m.add_argument("-o", "--output", metavar="ROBOT.yaml", help="write to this file (default: standard output)")
+    m.set_defaults(func=cmd_model)

@@ -1,0 +1,145 @@
+"""System models gathered from ROS: a recording's connections, the live graph (types from the
+master, definitions of types not installed from the publishers' TCPROS handshake, joint kinds
+from /robot_description), and installed message and service definitions."""
+from __future__ import annotations
+
+import os
+import socket
+import xml.etree.ElementTree as ElementTree
+from typing import Dict, Iterable, Optional, Tuple
+
+from ..lang.msgdef import DefinitionError, Registry, parse_full
+from ..lang.std_units import joint_state_units
+from ..lang.sysmodel import SystemModel
+from .bag import BagError, open_bag
+from .rpc import proxy as rpc_proxy
+
+CALLER = "/rubass_check"
+
+
+class LiveError(Exception):
+    """The live graph cannot be read (no master, …); the message says why, in one line."""
+
+
+def add_installed(registry: Registry, msg_types: Iterable[str], srv_types: Iterable[str] = ()) -> None:
+    """Add the installed definitions of these message and service types (and what they use)."""
+    import roslib.message
+
+    for t in msg_types:
+        if registry.get(t) is not None:
+            continue
+        try:
+            cls = roslib.message.get_message_class(t)
+            if cls is not None:
+                registry.add_full(t, cls._full_text)
+        except Exception:  # not installed, a broken package, a bad name: unknown here
+            continue
+    for t in srv_types:
+        if t in registry.services:
+            continue
+        try:
+            cls = roslib.message.get_service_class(t)
+            if cls is None:
+                continue
+            req = parse_full(t + "Request", cls._request_class._full_text)
+            resp = parse_full(t + "Response", cls._response_class._full_text)
+        except Exception:
+            continue
+        for spec in list(req.values()) + list(resp.values()):
+            registry.add(spec)
+        registry.add_service(t, req[t + "Request"], resp[t + "Response"])
+
+
+def bag_model(path: str) -> SystemModel:
+    """Topics, types, definitions and (when recorded) publishing nodes of a recording."""
+    bag, info = open_bag(path)
+    try:
+        registry = Registry()
+        for conn in bag._connections.values():  # rosbag keeps each connection's header here
+            try:
+                registry.add_full(conn.datatype, conn.msg_def)
+            except DefinitionError as exc:
+                raise BagError(f"{path}: topic {conn.topic}: {exc}") from None
+    finally:
+        bag.close()
+    # No node list: a bag names only publishers, and often as the recorder or player
+    # ('/play_1633455785917753240') rather than the node that ran on the robot.
+    return SystemModel(dict(info.types), None, registry, source=f"the recording {os.path.basename(path)}")
+
+
+def _master(uri: Optional[str]):  # type: ignore[no-untyped-def]
+    import rosgraph
+
+    master = rosgraph.Master(CALLER, master_uri=uri)
+    if not rosgraph.is_master_online(master.master_uri):
+        raise LiveError(f"no ROS master at {master.master_uri} (is roscore running? is ROS_MASTER_URI right?)")
+    return master
+
+
+def live_model(uri: Optional[str] = None, timeout: float = 2.0) -> SystemModel:
+    """Topics and types, nodes and definitions of the running graph."""
+    import rosgraph.masterapi
+
+    master = _master(uri)
+    try:
+        types = dict(master.getTopicTypes())
+        pubs, subs, srvs = master.getSystemState()
+    except (rosgraph.masterapi.Error, OSError) as exc:
+        raise LiveError(f"the master at {master.master_uri} does not answer: {exc}") from None
+    nodes = sorted({n for _, ns in list(pubs) + list(subs) + list(srvs) for n in ns})
+    registry = Registry()
+    add_installed(registry, set(types.values()))
+    for topic, publishers in pubs:
+        ty = types.get(topic)
+        if ty is None or ty == "*" or registry.get(ty) is not None:
+            continue
+        for node in publishers:
+            text = _definition_from_publisher(master, topic, node, timeout)
+            if text is not None:
+                try:
+                    registry.add_full(ty, text)
+                    break
+                except DefinitionError:
+                    continue
+    model = SystemModel({t: ty for t, ty in types.items() if ty != "*"}, nodes, registry,
+                        source=f"the live graph at {master.master_uri}")
+    kinds = _joint_kinds(master)
+    units = joint_state_units(kinds) if kinds else {}
+    for topic, ty in model.topics.items():
+        if ty == "sensor_msgs/JointState" and units:
+            model.topic_units[topic] = units
+    return model
+
+
+def _definition_from_publisher(master, topic: str, node: str, timeout: float) -> Optional[str]:  # type: ignore
+    """The message definition a publisher sends in its TCPROS handshake (no message is read)."""
+    from rosgraph.network import read_ros_handshake_header, write_ros_handshake_header
+
+    try:
+        api = master.lookupNode(node)
+        code, _, proto = rpc_proxy(api, timeout).requestTopic(CALLER, topic, [["TCPROS"]])
+        if code != 1 or not proto or proto[0] != "TCPROS":
+            return None
+        with socket.create_connection((proto[1], int(proto[2])), timeout=timeout) as sock:
+            write_ros_handshake_header(sock, {"topic": topic, "md5sum": "*", "type": "*", "callerid": CALLER})
+            header = read_ros_handshake_header(sock, bytearray(), 65536)
+    except Exception:  # a dead, hung or odd publisher: its type's fields stay unknown
+        return None
+    return header.get("message_definition") or None
+
+
+def _joint_kinds(master) -> Dict[str, str]:  # type: ignore[no-untyped-def]
+    """URDF joint name -> type from /robot_description; {} when absent or unreadable."""
+    try:
+        text = master.getParam("/robot_description")
+        root = ElementTree.fromstring(text)
+    except Exception:
+        return {}
+    return {j.get("name", ""): j.get("type", "") for j in root.iter("joint") if j.get("type") != "fixed"}
+
+
+def installed_registry(msg_types: Iterable[str], srv_types: Iterable[str] = ()) -> Tuple[Registry, str]:
+    """A registry of the installed definitions of these types, and where they were looked for."""
+    registry = Registry()
+    add_installed(registry, msg_types, srv_types)
+    return registry, "the message packages installed here"
