@@ -12,6 +12,8 @@ Parameters (private)
                                   after a master restart: docs/monitor.md)
     ~overload_actions (list)      actions to run while the engine's queue drops messages (fail safe)
     ~queue_size (default 100000)  messages the engine's queue holds (and 256 MiB of message bytes)
+    ~state_file (string)          latched actions kept across the monitor's restarts (default
+                                  $ROS_HOME/rubass/NODE.latches.json; false: off)
 Subscribes
     every topic the spec names, whatever its type (rospy.AnyMsg, tcp_nodelay)
 Publishes
@@ -51,12 +53,18 @@ from .master_watch import MasterWatch
 from .nodes import NodeSampler
 from .outputs import Outputs
 from .overload import OverloadGuard
+from .keeper import LatchKeeper
+from .latches import LatchFile, default_path
 from .params import MonitorConfig, ParamError, read_config
 from .topics import TopicWatcher
 
 
 class StartupError(Exception):
-    """The monitor cannot start: the message says why, for the user."""
+    """The spec, a library or an action cannot be used: the message says why, for the user."""
+
+
+class ConfigError(StartupError):
+    """The parameters do not fit the spec (~overload_actions): the monitor exits."""
 
 
 def _log(level: str, text: str) -> None:
@@ -79,6 +87,10 @@ class Monitor:
         self.coalesced = 0
         self._stopping = False
         self._exit = threading.Event()
+        self.spec: Optional[CheckedSpec] = None  # None while not enforcing (no usable spec yet)
+        self.runners: Dict[str, ActionRunner] = {}
+        self.loop: Optional[EngineLoop] = None
+        self.load_error = ""  # why the monitor is not enforcing, while it is not
 
     # -- start-up ------------------------------------------------------------------------
     def load(self) -> Tuple[CheckedSpec, Dict[str, ActionRunner]]:
@@ -95,7 +107,7 @@ class Monitor:
     def _check_overload_actions(self, spec: CheckedSpec) -> None:
         missing = [a for a in self.config.overload_actions if a not in spec.actions]
         if missing:
-            raise StartupError(f"{spec.path}: ~overload_actions names {', '.join(missing)}, which the spec does not "
+            raise ConfigError(f"{spec.path}: ~overload_actions names {', '.join(missing)}, which the spec does not "
                                f"declare (add 'action primitive {', '.join(missing)};')")
 
     def _runners(self, spec: CheckedSpec, keep: Dict[str, ActionRunner]) -> Dict[str, ActionRunner]:
@@ -118,23 +130,73 @@ class Monitor:
         return out
 
     def setup(self) -> None:
-        spec, runners = self.load()
-        self.spec = spec
-        self.runners = runners
+        """ROS scaffolding, then enforcement. A spec that cannot be used leaves the monitor up but not
+        enforcing: ERROR in /diagnostics, no ~heartbeat, until a reload brings a usable one."""
         self.outputs = Outputs()
-        self.dispatcher = Dispatcher(runners, self.outputs.event, _ros_now)
+        self.dispatcher = Dispatcher({}, self.outputs.event, _ros_now)
         self.overload = OverloadGuard(self.config.overload_actions, 1.0, _log, self.outputs.event)
+        self.keeper = LatchKeeper(LatchFile(self.config.state_file, self.config.spec), _log, self.outputs.event)
+        try:
+            spec, runners = self.load()
+        except ConfigError:
+            raise
+        except StartupError as exc:
+            self._not_enforcing(str(exc))
+        self._install_control()
+        if not self.load_error:
+            self._enforce(spec, runners)
+
+    def _not_enforcing(self, error: str) -> None:
+        self.load_error = error
+        rospy.logerr("rubass: NOT ENFORCING ANY RULE: cannot use the spec:\n%s\nThe monitor stays up without "
+                     "~heartbeat (a watchdog fed by it stops the robot); fix the file, then SIGHUP or "
+                     "rosservice call ~reload", error)
+
+    def _first_time(self) -> float:
+        """ROS time now; with use_sim_time, the first /clock message's (watching starts then, not at 0)."""
         now = _ros_now()
-        engine = Engine(spec, now)
-        self.loop = EngineLoop(engine, _ros_now, self.config.rate,
-                               lambda events, cause: self.dispatcher.handle(self.loop.engine, events, cause),
-                               max_queue=self.config.queue_size, tick_hook=self._tick)
+        if now == 0.0 and rospy.get_param("/use_sim_time", False):
+            rospy.logwarn("rubass: use_sim_time is set and no /clock message has come yet: waiting for the "
+                          "first one before watching (no ~heartbeat meanwhile; latched actions are held)")
+            while now == 0.0 and not self._exit.is_set() and not rospy.is_shutdown():
+                self._exit.wait(0.01)
+                now = _ros_now()
+            rospy.loginfo("rubass: first /clock message: %.3f s", now)
+        return now
+
+    def _on_events(self, events: List[Any], cause: Any) -> None:
+        """On the engine's thread: the latch state is written before a latched action is dispatched."""
+        engine = self.loop.engine  # type: ignore[union-attr]
+        if self.keeper.changes(engine, events):
+            self.keeper.save(engine, self.dispatcher.orphans, self._fail_safes())
+        self.dispatcher.handle(engine, events, cause)
+
+    def _fail_safes(self, starting: bool = False) -> List[List[str]]:
+        return [self.overload.actions] if self.overload.active or starting else []
+
+    def _enforce(self, spec: CheckedSpec, runners: Dict[str, ActionRunner]) -> None:
+        """Start the actions, restore latches, wait for the clock, then the first evaluation."""
+        self.spec, self.runners, self.dispatcher.runners = spec, runners, runners
+        self.keeper.file.spec_path = spec.path
         for runner in runners.values():
             runner.start_thread()
-        self.dispatcher.handle(engine, engine.evaluate_all(now), "reload")
+        self.keeper.restore(spec.actions, runners, _ros_now())  # before the first tick
+        now = self._first_time()
+        engine = Engine(spec, now)
+        self.loop = EngineLoop(engine, _ros_now, self.config.rate, self._on_events,
+                               max_queue=self.config.queue_size, tick_hook=self._tick)
+        self._on_events(engine.evaluate_all(now), "reload")
+        self.keeper.save(engine, self.dispatcher.orphans, self._fail_safes())
         self.watcher = TopicWatcher(self._on_message, _log)
         self.watcher.sync(spec)
         self.sampler = self._sampler(spec)
+        self.load_error = ""
+        rospy.loginfo("rubass: enforcing %s (%d rules, %d behaviours, %d topics, %d nodes)", spec.path,
+                      len(spec.rules), len(spec.behaviours), len(spec.topics), len(spec.nodes))
+        threading.Thread(target=self._engine_thread, name="rubass-engine", daemon=True).start()
+
+    def _install_control(self) -> None:
+        """Services, signals and the master watch: up whether or not the spec can be enforced."""
         self.master_watch = MasterWatch(rospy.get_caller_id(), rospy.core.get_node_uri(), rosgraph.get_master_uri(),
                                         1.0 / self.config.master_rate, _log)
         rospy.Service("~reload", Trigger, lambda req: TriggerResponse(*self.reload("service")))
@@ -146,14 +208,18 @@ class Monitor:
         for sig in (signal.SIGINT, signal.SIGTERM):
             signal.signal(sig, lambda signum, frame: self._exit.set())
         self.master_watch.start()
-        rospy.loginfo("rubass: enforcing %s (%d rules, %d behaviours, %d topics, %d nodes)", spec.path,
-                      len(spec.rules), len(spec.behaviours), len(spec.topics), len(spec.nodes))
 
     def _tick(self, now: float) -> None:
         """On the engine's thread at each tick: the heartbeat, then the overload check."""
         self.outputs.beat(now)
-        self.overload.check(self.loop.dropped, now, self.dispatcher.runners,
-                            lambda name: self.loop.engine.spec.actions[name].latch)
+        loop = self.loop
+        assert loop is not None
+        was = self.overload.active
+        if not was and self.overload.would_start(loop.dropped):  # written before the fail-safe runs
+            self.keeper.save(loop.engine, self.dispatcher.orphans, self._fail_safes(starting=True))
+        self.overload.check(loop.dropped, now, self.dispatcher.runners, lambda name: loop.engine.spec.actions[name].latch)
+        if was and not self.overload.active:
+            self.keeper.save(loop.engine, self.dispatcher.orphans, self._fail_safes())
 
     def _sampler(self, spec: CheckedSpec) -> NodeSampler:
         nodes = [(n, rospy.resolve_name(n)) for n in sorted(spec.nodes)]
@@ -170,8 +236,6 @@ class Monitor:
 
     # -- running -------------------------------------------------------------------------
     def run(self) -> None:
-        thread = threading.Thread(target=self._engine_thread, name="rubass-engine", daemon=True)
-        thread.start()
         period = 1.0 / self.config.diagnostics_rate
         while not rospy.is_shutdown() and not self._exit.is_set():
             try:
@@ -180,13 +244,14 @@ class Monitor:
                 rospy.logerr_throttle(10, f"rubass: status failed: {exc}")
             self._exit.wait(period)
         self.shutdown()
-        thread.join(2.0)
         rospy.signal_shutdown("rubass monitor stopped")
 
     def _engine_thread(self) -> None:
+        loop = self.loop
+        assert loop is not None
         while not self._stopping:
             try:
-                self.loop.step(max_wait=0.1)
+                loop.step(max_wait=0.1)
             except Exception as exc:  # a bug must not silently stop enforcement: log and go on
                 rospy.logerr_throttle(1, f"rubass: engine step failed: {exc.__class__.__name__}: {exc}")
 
@@ -212,6 +277,11 @@ class Monitor:
                 spec = self._load_stable()
                 self._check_overload_actions(spec)
                 t_check = time.monotonic()
+                if self.spec is None:  # not enforcing yet: this spec is the first usable one
+                    self._enforce(spec, self._runners(spec, {}))
+                    self.reloads += 1
+                    self.last_reload_error = ""
+                    return True, f"enforcing {spec.path}: {len(spec.rules)} rules, {len(spec.behaviours)} behaviours"
                 if spec.behaviours == [] and self.spec.behaviours:
                     raise StartupError(f"{spec.path}: the new spec has no behaviours; refusing to drop every "
                                        f"safety behaviour of the running spec (was the file caught half-written? "
@@ -221,6 +291,8 @@ class Monitor:
                 text = exc.render() if isinstance(exc, SpecError) else str(exc)
                 self.rejected += 1
                 self.last_reload_error = text.splitlines()[0] if text else "error"
+                if self.spec is None:
+                    self.load_error = text
                 rospy.logerr("rubass: reload (%s) rejected, the previous rules keep running:\n%s", reason, text)
                 return False, f"rejected: {text}"
             new_engine = Engine(spec, _ros_now())
@@ -228,7 +300,7 @@ class Monitor:
             for name, runner in runners.items():
                 if self.runners.get(name) is not runner:
                     runner.start_thread()
-            self.loop.call(lambda old: self._swap(old, new_engine, spec, runners))
+            self.loop.call(lambda old: self._swap(old, new_engine, spec, runners))  # type: ignore[union-attr]
             t_swap = time.monotonic()
             self.watcher.sync(spec)
             if spec.nodes != self.spec.nodes:
@@ -271,12 +343,20 @@ class Monitor:
                 self.dispatcher.orphans.append((b, old_keys[b.index]))
             else:
                 self.dispatcher.release(b, old_keys[b.index], now)
+        for name, runner in runners.items():  # actions are carried across any reload by name
+            prev = self.dispatcher.runners.get(name)
+            if prev is not None and prev is not runner:
+                runner.adopt(prev)
         self.dispatcher.runners = runners
-        self.loop.engine = new
+        self.loop.engine = new  # type: ignore[union-attr]
         self.dispatcher.handle(new, events, "reload")
+        self.keeper.save(new, self.dispatcher.orphans, self._fail_safes())
 
     def reset(self) -> Tuple[bool, str]:
         now = _ros_now()
+        loop = self.loop
+        if loop is None:
+            return False, f"not enforcing any rule (the spec cannot be used): {self.load_error.splitlines()[0]}"
 
         def do(engine: Engine) -> int:
             events = engine.reset(now)
@@ -284,10 +364,12 @@ class Monitor:
             n = len(self.dispatcher.orphans)
             self.dispatcher.release_orphans(now)
             n += self.overload.reset(now, self.dispatcher.runners)
+            n += self.keeper.reset(self.dispatcher.runners, now)
+            self.keeper.save(engine, self.dispatcher.orphans, self._fail_safes())
             return sum(e.kind == "release" for e in events) + n
 
-        released = self.loop.call(do)
-        still = self.loop.call(lambda engine: engine.active_behaviours())
+        released = loop.call(do)
+        still = loop.call(lambda engine: engine.active_behaviours())
         msg = f"released {released} latched behaviour{'s' if released != 1 else ''}"
         if still:
             msg += f"; still active (cause present): {', '.join(str(i) for i in still)}"
@@ -295,10 +377,16 @@ class Monitor:
         return True, msg
 
     def publish_status(self) -> None:
+        if self.loop is None:
+            self.outputs.status(status_mod.not_enforcing(self.config.spec, self.load_error, self.reloads,
+                                                         self.rejected), _ros_now())
+            return
+        loop = self.loop
+
         def snapshot(engine: Engine) -> Tuple[Dict[str, Any], List[int], Dict[Tuple[str, str], str]]:
             return dict(engine.store.rules), engine.active_behaviours(), dict(engine.field_errors)
 
-        rules, active, field_errors = self.loop.call(snapshot)
+        rules, active, field_errors = loop.call(snapshot)
         topics = {s.spec_name: {"messages": s.messages, "errors": s.errors, "type": s.type}
                   for s in self.watcher.status()}
         nodes = {s.spec_name: {"why": s.why} for s in self.sampler.status.values()}
@@ -307,7 +395,7 @@ class Monitor:
         monitor: Dict[str, Any] = {
             "spec": self.spec.path, "reloads": self.reloads, "rejected reloads": self.rejected,
             "coalesced reload requests": self.coalesced,
-            "last reload error": self.last_reload_error, "dropped messages": self.loop.dropped,
+            "last reload error": self.last_reload_error, "dropped messages": loop.dropped,
             "overloaded": "running " + ", ".join(self.overload.actions) if self.overload.active else "no",
             "action failures": failures,
             "master": self.master_watch.state, "master re-registrations": self.master_watch.reregistrations,
@@ -316,12 +404,19 @@ class Monitor:
         for name, r in self.runners.items():
             if r.stats.last_error:
                 monitor[f"action {name}"] = r.stats.last_error
+        monitor.update(self.keeper.status())
+        assert self.spec is not None
         entries = status_mod.build(self.spec, rules, active, topics, nodes, field_errors, monitor)
         self.outputs.status(entries, _ros_now())
 
     def shutdown(self) -> None:
         """Release non-latched actions, close ports and publishers."""
         if self._stopping:
+            return
+        loop = self.loop
+        if loop is None:  # not enforcing: nothing to release
+            self._stopping = True
+            self.master_watch.stop()
             return
         now = _ros_now()
 
@@ -336,16 +431,16 @@ class Monitor:
 
         rospy.loginfo("rubass: stopping: releasing non-latched actions")
         try:
-            self.loop.call(release, timeout=1.0)
+            loop.call(release, timeout=1.0)
         except Exception as exc:  # the engine thread is stuck: stop anyway
             rospy.logerr(f"rubass: could not release actions at shutdown: {exc}")
         self._stopping = True
         self.master_watch.stop()
-        self.loop.stop()
+        loop.stop()
         self.sampler.stop()
         received = sum(st.messages for st in self.watcher.status())
         rospy.loginfo("rubass: stopped after %d messages (%d dropped: the engine's queue was full), %d reloads",
-                      received, self.loop.dropped, self.reloads)
+                      received, loop.dropped, self.reloads)
         self.watcher.close()
         for runner in self.runners.values():
             runner.stop(timeout=1.0)
@@ -372,10 +467,11 @@ def main(argv: Optional[List[str]] = None) -> int:
     rospy.init_node("rubass_monitor", argv=argv, disable_signals=True)  # Monitor handles SIGINT/SIGTERM
     sys.setswitchinterval(0.0005)  # a busy thread must not delay a deadline by the default 5 ms
     try:
-        config = read_config(lambda name, default: rospy.get_param("~" + name, default))
+        config = read_config(lambda name, default: rospy.get_param("~" + name, default),
+                             default_path(os.environ.get("ROS_HOME"), rospy.get_name()))
         monitor = Monitor(config)
         monitor.setup()
-    except (ParamError, StartupError) as exc:
+    except (ParamError, ConfigError) as exc:
         rospy.logfatal("rubass: cannot start:\n%s", exc)
         print(f"rubass monitor: cannot start:\n{exc}", file=sys.stderr)
         rospy.signal_shutdown("cannot start")

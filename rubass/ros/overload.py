@@ -40,6 +40,10 @@ class OverloadGuard:
         else:
             self._send("hold", now, runners)
 
+    def would_start(self, dropped: int) -> bool:
+        """Whether check() with this drop count starts the fail-safe actions."""
+        return dropped > self._seen and not self.active and bool(self.actions)
+
     def release(self, now: float, runners: Dict[str, Any], why: str) -> None:
         if self.active:
             self.active = False

@@ -3,7 +3,7 @@ from __future__ import annotations
 
 import os
 from dataclasses import dataclass, field
-from typing import Any, Callable, List
+from typing import Any, Callable, List, Optional
 
 from ..lang.units import FREQUENCY, parse_quantity
 
@@ -25,6 +25,7 @@ class MonitorConfig:
     master_rate: float = 4.0  # checks per second that the master still knows the monitor
     overload_actions: List[str] = field(default_factory=list)  # run while messages are dropped
     queue_size: int = 100000  # messages the engine's queue holds
+    state_file: Optional[str] = None  # latched actions kept across restarts; None: off
 
 
 def _rate(get: Getter, name: str, default: float, lo: float, hi: float) -> float:
@@ -50,8 +51,19 @@ def _names(get: Getter, name: str, what: str) -> List[str]:
     return value
 
 
-def read_config(get: Getter) -> MonitorConfig:
-    """The configuration from a param getter (rospy.get_param with '~' names, or a dict's get)."""
+def _state_file(get: Getter, default: Optional[str]) -> Optional[str]:
+    value = get("state_file", default)
+    if value is False or value is None:
+        return None
+    if not isinstance(value, str) or not value.strip():
+        raise ParamError(f"~state_file must be the path of the latch state file, or false to keep no state "
+                         f"(a latched stop then does not survive the monitor's restart), got {value!r}")
+    return os.path.expanduser(value)
+
+
+def read_config(get: Getter, default_state_file: Optional[str] = None) -> MonitorConfig:
+    """The configuration from a param getter (rospy.get_param with '~' names, or a dict's get);
+    default_state_file: where latches are kept when ~state_file is not given."""
     spec = get("spec", _MISSING)
     if spec is _MISSING:
         raise ParamError("~spec is required: the RuBaSS spec to enforce, e.g. "
@@ -72,4 +84,5 @@ def read_config(get: Getter) -> MonitorConfig:
         master_rate=_rate(get, "master_rate", 4.0, 0.1, 100.0),
         overload_actions=overload,
         queue_size=queue_size,
+        state_file=_state_file(get, default_state_file),
     )

@@ -80,6 +80,11 @@ def build(spec: CheckedSpec, rules: Dict[str, Any], active: List[int], topics: D
     mvalues = [(k, str(v)) for k, v in monitor.items()]
     mvalues.append(("active behaviours", ", ".join(str(i) for i in active) or "none"))
     level = ERROR if monitor.get("last reload error") or monitor.get("action failures") else OK
+    if monitor.get("latch state error"):  # a latched stop may not survive a restart, or one was restored blind
+        level = ERROR
+        msg_latch = f" (latch state: {monitor['latch state error']})"
+    else:
+        msg_latch = ""
     msg = f"enforcing {spec.path}: {len(spec.rules)} rules, {len(spec.behaviours)} behaviours"
     if monitor.get("overloaded", "no") != "no":
         level = ERROR
@@ -89,5 +94,14 @@ def build(spec: CheckedSpec, rules: Dict[str, Any], active: List[int], topics: D
         msg += f" (master {monitor['master']})"
     if monitor.get("last reload error"):
         msg += " (the last reload was rejected; the previous rules still run)"
+    msg += msg_latch
     out.append(Entry("rubass: monitor", level, msg, mvalues))
     return out
+
+
+def not_enforcing(spec_path: str, error: str, reloads: int, rejected: int) -> List[Entry]:
+    """The monitor's only status while no spec could be used: ERROR, naming the file and the error."""
+    first = error.splitlines()[0] if error else "no spec loaded"
+    return [Entry("rubass: monitor", ERROR, f"NOT ENFORCING ANY RULE: {first}",
+                  [("spec", spec_path), ("error", error), ("reloads", str(reloads)),
+                   ("rejected reloads", str(rejected)), ("heartbeat", "not published until a usable spec is loaded")])]

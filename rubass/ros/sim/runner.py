@@ -158,7 +158,9 @@ def run_once(session: Session, row: Row, rep: int) -> RunResult:
         if row.robot == "frobit":
             _wait(lambda: os.path.lexists(os.path.join(run_dir, "board")), 15, "the safety board's port")
         monitor = spawn("monitor", [PY, os.path.join(ROOT, "scripts", "monitor"), "__name:=rubass",
-                                    f"_spec:={spec_path}", "_node_rate:=10"])
+                                    f"_spec:={spec_path}", "_node_rate:=10",
+                                    # each run starts unlatched: its own latch state file (issue 13)
+                                    f"_state_file:={os.path.join(run_dir, 'latches.json')}"])
         wait_for_service("/rubass/reset", monitor, session.master.uri, 30)
         expected = 3 if row.robot == "kobuki" else 2  # the nodes that listen to /sim/fault
         _wait(lambda: session.faults.get_num_connections() >= expected, 15, "the simulated nodes")

@@ -1,0 +1,96 @@
+"""Keeps the latch state file in step with what is latched: behaviours of the running spec, latched
+behaviours a reload removed, the overload and data-error fail-safes, and latches restored from a
+previous run (held until ~reset). See latches.py for the file and why it exists.
+
+Runs on the engine's thread (its calls come from the event handler, the tick, reset and reload).
+"""
+from __future__ import annotations
+
+from typing import Any, Callable, Dict, List, Sequence
+
+from ..engine import Engine, Event
+from .actions.base import Context
+from .latches import Latch, LatchFile, holders, load
+
+Log = Callable[[str, str], None]
+Report = Callable[[Dict[str, Any]], None]
+RESTORED = "rubass-restored"  # the runners' identity for a restored latch: (RESTORED, holder)
+
+
+def behaviour_holder(b: Any) -> str:
+    return f"behaviour {b.index} (line {b.span.line})"
+
+
+class LatchKeeper:
+    def __init__(self, file: LatchFile, log: Log, report: Report) -> None:
+        self.file = file
+        self.log = log
+        self.report = report
+        self.restored: List[Latch] = []
+        self.problems: List[str] = []  # what was wrong with the file at start
+
+    # -- start ---------------------------------------------------------------------------
+    def restore(self, actions: Dict[str, Any], runners: Dict[str, Any], now: float) -> None:
+        """Before the first tick: start again every latched action the previous run held."""
+        if self.file.path is None:
+            return
+        latches, self.problems = load(self.file.path, {n: bool(a.latch) for n, a in actions.items()})
+        for p in self.problems:
+            self.log("error", p)
+        for latch in latches:
+            names = [a for a in latch.actions if a in runners]
+            for name in names:
+                runners[name].submit("start", self._ctx(latch, now))
+            self.restored.append(latch)
+            self.log("error", f"latched before the monitor stopped ({latch.holder}): {', '.join(latch.actions)} "
+                              f"active again until ~reset (ISO 3691-4: no automatic restart after a protective stop)")
+            self.report({"time": now, "event": "start", "behaviour": 0, "line": 0, "actions": list(latch.actions),
+                         "rules": [], "cause": f"restored: {latch.holder}", "latency_ms": None})
+
+    @staticmethod
+    def _ctx(latch: Latch, now: float) -> Context:
+        return Context(0, 0, (), (), now, (RESTORED, latch.holder))
+
+    # -- state ---------------------------------------------------------------------------
+    def changes(self, engine: Engine, events: Sequence[Event]) -> bool:
+        """Whether these events start or release a latched behaviour (the file must follow)."""
+        bs = engine.spec.behaviours
+        return any(e.kind in ("start", "release") and bs[e.behaviour - 1].latched for e in events)
+
+    def save(self, engine: Engine, orphans: Sequence[Any], fail_safes: Sequence[Sequence[str]]) -> None:
+        """Write the state now: call it before a latched action is dispatched."""
+        spec = engine.spec
+        items = []
+        for index in engine.active_behaviours():
+            b = spec.behaviours[index - 1]
+            items.append((behaviour_holder(b), [a.name for a in b.actions if a.action.latch]))
+        for b, _key in orphans:
+            items.append((behaviour_holder(b) + " of a replaced spec", [a.name for a in b.actions if a.action.latch]))
+        for i, names in enumerate(fail_safes):
+            items.append((f"fail-safe {i}", [a for a in names if a in spec.actions and spec.actions[a].latch]))
+        items += [(r.holder, r.actions) for r in self.restored]
+        if not self.file.save(holders(items)):
+            self.log("error", f"{self.file.error}: a latched stop would not survive the monitor's restart")
+
+    def reset(self, runners: Dict[str, Any], now: float) -> int:
+        """~reset: release the restored latches; how many there were."""
+        n = len(self.restored)
+        for latch in self.restored:
+            for name in latch.actions:
+                if name in runners:
+                    runners[name].submit("release", self._ctx(latch, now))
+            self.report({"time": now, "event": "release", "behaviour": 0, "line": 0, "actions": list(latch.actions),
+                         "rules": [], "cause": "reset service", "latency_ms": None})
+        self.restored = []
+        return n
+
+    def status(self) -> Dict[str, str]:
+        out: Dict[str, str] = {}
+        if self.restored:
+            out["latched at start (until ~reset)"] = "; ".join(f"{', '.join(r.actions)} ({r.holder})"
+                                                                for r in self.restored)
+        errors = self.problems + ([self.file.error] if self.file.error else [])
+        if errors:
+            out["latch state error"] = "; ".join(errors)
+        out["latch state file"] = self.file.path or "off (~state_file: false)"
+        return out

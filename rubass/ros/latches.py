@@ -1,0 +1,148 @@
+"""Latched actions persisted across the monitor's own death.
+
+ISO 3691-4 forbids an automatic restart after a protective stop: a latched stop that is active
+when the monitor dies (SIGKILL, a crash, a power cut of its computer) must be active again when
+it is started again (`respawn="true"`), until `~reset`. The file names the latched actions and
+the behaviours holding them; it is written (atomically: a temporary file renamed over it) before
+a latched action is dispatched, and read before the first tick. A file that cannot be read as
+one of ours is reported and treated as "latched" for every action it names (for every latched
+action of the spec when it names none): the robot stays stopped rather than restarts.
+
+No ROS here: the path is given, the format is JSON, so it is tested without a master.
+"""
+from __future__ import annotations
+
+import json
+import os
+import re
+import threading
+from dataclasses import dataclass
+from typing import Any, Dict, Iterable, List, Optional, Sequence, Tuple
+
+FORMAT = "rubass-latches"
+VERSION = 1
+
+
+@dataclass(frozen=True)
+class Latch:
+    """One holder of latched actions: a behaviour (by its label and line) or the monitor itself."""
+
+    holder: str  # "behaviour 2 (line 7)", "overload", "restored …"
+    actions: Tuple[str, ...]
+
+
+def default_path(ros_home: Optional[str], node_name: str) -> str:
+    """$ROS_HOME/rubass/NODE.latches.json (ROS_HOME defaults to ~/.ros, as for ROS's own logs)."""
+    home = ros_home or os.path.join(os.path.expanduser("~"), ".ros")
+    return os.path.join(home, "rubass", (node_name.strip("/").replace("/", "_") or "rubass") + ".latches.json")
+
+
+def load(path: str, declared: Dict[str, bool]) -> Tuple[List[Latch], List[str]]:
+    """The latches a previous run left (none if there is no file) and the problems found.
+
+    declared: the spec's action names -> whether each is latched. Actions the file names that
+    the spec does not declare cannot be held: they are reported.
+    """
+    try:
+        with open(path, "rb") as fh:
+            raw = fh.read(1 << 20)
+    except FileNotFoundError:
+        return [], []
+    except OSError as exc:
+        return _fallback(b"", declared, f"latch state {path} cannot be read ({exc.strerror})")
+    try:
+        data = json.loads(raw.decode("utf-8"))
+        if not isinstance(data, dict) or data.get("format") != FORMAT:
+            raise ValueError("not a rubass latch state file")
+        if data.get("version") != VERSION:
+            raise ValueError(f"written by another version of rubass (version {data.get('version')!r})")
+        entries = data["latched"]
+        if not isinstance(entries, list):
+            raise ValueError("'latched' is not a list")
+        latches = []
+        for e in entries:
+            actions = e["actions"]
+            if not isinstance(e["holder"], str) or not isinstance(actions, list) or \
+                    not all(isinstance(a, str) for a in actions):
+                raise ValueError(f"bad entry {e!r}")
+            latches.append(Latch(e["holder"], tuple(actions)))
+    except (ValueError, KeyError, TypeError, UnicodeDecodeError) as exc:
+        return _fallback(raw, declared, f"latch state {path} is corrupt or foreign ({exc})")
+    problems = []
+    out = []
+    for latch in latches:
+        known = tuple(a for a in latch.actions if a in declared)
+        unknown = [a for a in latch.actions if a not in declared]
+        if unknown:
+            problems.append(f"latch state {path}: {latch.holder} held {', '.join(unknown)}, which the spec does not "
+                            f"declare: cannot hold {'it' if len(unknown) == 1 else 'them'}")
+        if known:
+            out.append(Latch(latch.holder, known))
+    return out, problems
+
+
+def _fallback(raw: bytes, declared: Dict[str, bool], why: str) -> Tuple[List[Latch], List[str]]:
+    """A file we cannot trust: every declared action it names is latched; if it names none,
+    every latched action of the spec is (the safe reading of a damaged protective-stop record)."""
+    text = raw.decode("utf-8", errors="replace")
+    named = [a for a in declared if re.search(r"(?<![A-Za-z0-9_])" + re.escape(a) + r"(?![A-Za-z0-9_])", text)]
+    actions = tuple(named) if named else tuple(a for a, latched in declared.items() if latched)
+    if not actions:
+        return [], [why + "; it names no action the spec declares"]
+    return [Latch("restored from a damaged latch state file", actions)], \
+        [why + f"; treated as latched: {', '.join(actions)} (until ~reset)"]
+
+
+class LatchFile:
+    """Writes the latch state when it changes; `path` None turns persistence off."""
+
+    def __init__(self, path: Optional[str], spec_path: str = "") -> None:
+        self.path = path
+        self.spec_path = spec_path
+        self.error = ""  # the last write error, "" when the file is up to date
+        self._last: Optional[Tuple[Latch, ...]] = None
+        self._lock = threading.Lock()
+
+    def save(self, latches: Sequence[Latch]) -> bool:
+        """Write the state if it changed; False (and self.error set) if it could not be written."""
+        if self.path is None:
+            return True
+        state = tuple(sorted(set(latches), key=lambda l: (l.holder, l.actions)))
+        with self._lock:
+            if state == self._last and not self.error:
+                return True
+            body = json.dumps({"format": FORMAT, "version": VERSION, "spec": self.spec_path,
+                               "latched": [{"holder": l.holder, "actions": list(l.actions)} for l in state]},
+                              indent=1)
+            tmp = f"{self.path}.{os.getpid()}.tmp"
+            try:
+                os.makedirs(os.path.dirname(self.path) or ".", exist_ok=True)
+                with open(tmp, "w", encoding="utf-8") as fh:
+                    fh.write(body)
+                os.replace(tmp, self.path)  # survives the process's death from here on
+            except OSError as exc:
+                self.error = f"cannot write the latch state {self.path}: {exc.strerror or exc}"
+                return False
+            self._last, self.error = state, ""
+        if state:  # on disk too before a power cut, without holding the engine's thread for it
+            threading.Thread(target=_sync, args=(self.path,), name="rubass-latch-sync", daemon=True).start()
+        return True
+
+
+def _sync(path: str) -> None:
+    try:
+        fd = os.open(path, os.O_RDONLY)
+        try:
+            os.fsync(fd)
+        finally:
+            os.close(fd)
+    except OSError:
+        pass
+
+
+def holders(items: Iterable[Tuple[str, Iterable[str]]]) -> List[Latch]:
+    """Latch entries from (holder, latched action names), skipping holders with none."""
+    return [Latch(h, tuple(a)) for h, a in items if tuple(a)]
+
+
+__all__: List[Any] = ["Latch", "LatchFile", "default_path", "holders", "load"]

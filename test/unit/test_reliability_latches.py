@@ -1,0 +1,56 @@
+"""The latch state file (issue 13, item 6): round trip, atomic write, corrupt and foreign files."""
+import json
+import os
+
+from rubass.ros.latches import Latch, LatchFile, default_path, load
+
+DECLARED = {"stop": True, "brake": False, "warn": False}
+
+
+def test_default_path_is_under_ros_home_and_named_after_the_node(tmp_path):
+    assert default_path(str(tmp_path), "/ns/rubass") == str(tmp_path / "rubass" / "ns_rubass.latches.json")
+    assert default_path(None, "/rubass").endswith(os.path.join(".ros", "rubass", "rubass.latches.json"))
+
+
+def test_round_trip_and_no_file_means_nothing_latched(tmp_path):
+    path = str(tmp_path / "d" / "s.json")
+    assert load(path, DECLARED) == ([], [])
+    f = LatchFile(path, "/s.rbs")
+    assert f.save([Latch("behaviour 1 (line 4)", ("stop",))])
+    assert load(path, DECLARED) == ([Latch("behaviour 1 (line 4)", ("stop",))], [])
+    assert not [n for n in os.listdir(tmp_path / "d") if n.endswith(".tmp")]
+    assert f.save([]) and load(path, DECLARED) == ([], [])
+
+
+def test_a_write_that_fails_is_reported_not_raised(tmp_path):
+    (tmp_path / "file").write_text("x")
+    f = LatchFile(str(tmp_path / "file" / "s.json"))
+    assert not f.save([Latch("b", ("stop",))])
+    assert "cannot write the latch state" in f.error
+
+
+def test_a_truncated_file_latches_the_actions_it_names(tmp_path):
+    path = tmp_path / "s.json"
+    path.write_text('{"format": "rubass-latches", "version": 1, "latched": [{"holder": "b", "actions": ["brake"')
+    latches, problems = load(str(path), DECLARED)
+    assert latches == [Latch("restored from a damaged latch state file", ("brake",))]
+    assert "corrupt or foreign" in problems[0] and "treated as latched: brake" in problems[0]
+
+
+def test_garbage_naming_nothing_latches_every_latched_action(tmp_path):
+    path = tmp_path / "s.json"
+    path.write_bytes(b"\x00\xff\xfe")
+    latches, problems = load(str(path), DECLARED)
+    assert latches[0].actions == ("stop",) and problems
+
+
+def test_a_foreign_file_and_undeclared_actions_are_reported(tmp_path):
+    path = tmp_path / "s.json"
+    path.write_text(json.dumps({"format": "rubass-latches", "version": 99,
+                                "latched": [{"holder": "b", "actions": ["stop"]}]}))
+    latches, problems = load(str(path), DECLARED)
+    assert latches[0].actions == ("stop",) and "another version" in problems[0]
+    path.write_text(json.dumps({"format": "rubass-latches", "version": 1,
+                                "latched": [{"holder": "b", "actions": ["stop", "halt"]}]}))
+    latches, problems = load(str(path), DECLARED)
+    assert latches == [Latch("b", ("stop",))] and "halt" in problems[0] and "cannot hold" in problems[0]
