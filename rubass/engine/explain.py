@@ -68,10 +68,38 @@ class Witness:
         return out
 
 
+_NODE_UNITS = {"cpu": "cores", "memory": "B", "alive": ""}
+
+
+def _checked_label(e: ast.Expr) -> Optional[Tuple[str, str]]:
+    """(label, unit) of a checked built-in (version 2 AST), or None."""
+    A = ast
+    if isinstance(e, getattr(A, "Age", ())):
+        return f"age({e.topic})", "s"  # type: ignore[union-attr]
+    if isinstance(e, getattr(A, "StampAge", ())):
+        return f"stamp_age({e.topic})", "s"  # type: ignore[union-attr]
+    if isinstance(e, getattr(A, "Frequency", ())):
+        w = e.window  # type: ignore[union-attr]
+        return (f"frequency({e.topic})" if w == 1.0 else f"frequency({e.topic}, {w:g} s)"), "Hz"  # type: ignore[union-attr]
+    if isinstance(e, getattr(A, "NodeStat", ())):
+        return f"{e.attr}({e.node})", _NODE_UNITS.get(e.attr, "")  # type: ignore[union-attr]
+    if isinstance(e, getattr(A, "Rate", ())):
+        return f"rate({e.ref.topic}{e.ref.path_text})", "/s"  # type: ignore[union-attr]
+    if isinstance(e, getattr(A, "ArrayFn", ())):
+        ref = e.ref  # type: ignore[union-attr]
+        return f"{e.func}({ref.topic}{ref.path_text}{ast.path_suffix(e.elem)})", ""  # type: ignore[union-attr]
+    if isinstance(e, getattr(A, "Active", ())):
+        return f"active({e.action})", ""  # type: ignore[union-attr]
+    return None
+
+
 def label(e: ast.Expr) -> Optional[str]:
     """How a witness names a term, or None for what is not a reading."""
     if isinstance(e, ast.TopicRef):
         return e.topic + e.path_text
+    checked = _checked_label(e)
+    if checked is not None:
+        return checked[0]
     if isinstance(e, ast.Call) and (e.func in _UNITS or e.func in _ARRAY_FNS):
         if e.func in _ARRAY_FNS and (len(e.args) != 1 or not isinstance(e.args[0], ast.TopicRef)):
             return None  # min(x, y): arithmetic, its operands are readings of their own
@@ -160,7 +188,9 @@ class Explainer:
                 fn = self._compile(e)
             except Exception:  # a construct this explainer cannot read alone: leave it out
                 continue
-            out.append((term, _UNITS.get(e.func, ""), fn))  # type: ignore[union-attr]
+            checked = _checked_label(e)
+            unit = checked[1] if checked is not None else _UNITS.get(getattr(e, "func", ""), "")
+            out.append((term, unit, fn))
         self._readers[key] = out
         return out
 
@@ -175,9 +205,11 @@ def _terms(expr: ast.Expr) -> Sequence[ast.Expr]:
     out: List[ast.Expr] = []
 
     def visit(e: ast.Expr) -> None:
-        if isinstance(e, ast.Call) and label(e) is not None:
+        if (isinstance(e, ast.Call) or _checked_label(e) is not None) and label(e) is not None:
             out.append(e)
             return
+        if type(e).__name__ == "Quant":
+            return  # its body reads one element at a time: no single value to show
         if isinstance(e, ast.TopicRef):
             if e.path:
                 out.append(e)
