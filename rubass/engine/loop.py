@@ -9,7 +9,7 @@ from __future__ import annotations
 import queue
 import threading
 from dataclasses import dataclass
-from typing import Any, Callable, List, Optional, Tuple
+from typing import Any, Callable, Dict, List, Optional, Tuple
 
 from .engine import Engine, Event
 
@@ -55,6 +55,12 @@ class EngineLoop:
         self.tick_hook = tick_hook
         self.inbox: "queue.Queue[Any]" = queue.Queue(maxsize=max_queue)
         self.dropped = 0
+        self.dropped_by_topic: Dict[str, int] = {}  # what was dropped, for the overload fail-safe's log
+        # Conflation: when the queue is full, the newest message of each topic waits here (it
+        # replaces an older one of its topic), is handled at the engine's next step, and older
+        # messages of its topic still queued are then skipped: the newest value is never lost.
+        self._newest: Dict[str, Message] = {}
+        self._applied: Dict[str, float] = {}  # topic -> time of the newest message handled out of turn
         self.max_bytes = max_bytes  # the queue holds at most this many message bytes (8 MB clouds…)
         self.queued_bytes = 0
         self._bytes_lock = threading.Lock()
@@ -63,21 +69,32 @@ class EngineLoop:
 
     # -- any thread ----------------------------------------------------------------------
     def submit(self, item: Any) -> bool:
-        """Queue an input; False (and counted) if the queue is full, by count or by bytes."""
+        """Queue an input; False if the queue is full, by count or by bytes: then a message is kept
+        as its topic's newest (conflation) and the one it replaces, if any, is counted as dropped."""
         size = item.size if isinstance(item, Message) else 0
         if size:
             with self._bytes_lock:
                 if self.queued_bytes + size > self.max_bytes:
-                    self.dropped += 1
+                    self._conflate(item)
                     return False
                 self.queued_bytes += size
         try:
             self.inbox.put_nowait(item)
             return True
         except queue.Full:
-            self.dropped += 1
             self._unqueue(size)
+            if isinstance(item, Message):
+                with self._bytes_lock:
+                    self._conflate(item)
+            else:
+                self.dropped += 1
             return False
+
+    def _conflate(self, item: "Message") -> None:
+        """Under _bytes_lock: keep `item` as its topic's newest; the one it replaces is dropped."""
+        self.dropped += 1  # one message of this topic will never be seen: the replaced one, or queued ones
+        self.dropped_by_topic[item.topic] = self.dropped_by_topic.get(item.topic, 0) + 1
+        self._newest[item.topic] = item
 
     def _unqueue(self, size: int) -> None:
         if size:
@@ -123,6 +140,10 @@ class EngineLoop:
             item = None
         if item is not None:
             self._handle(item)
+        if self._newest:
+            self._handle_newest()
+        elif self._applied and self.inbox.empty():
+            self._applied.clear()  # every message queued before those has been handled
         now = self.clock()
         deadline = self.engine.next_deadline()
         if deadline is not None and deadline <= now:
@@ -135,9 +156,19 @@ class EngineLoop:
             if self._next_tick <= now:  # ticks were missed (a stall): go on from now, no burst
                 self._next_tick = now + self.period
 
+    def _handle_newest(self) -> None:
+        """The newest message of each topic that overflowed, in time order, before older queued ones."""
+        with self._bytes_lock:
+            items, self._newest = sorted(self._newest.values(), key=lambda m: m.time), {}
+        for m in items:
+            self._applied[m.topic] = m.time
+            self._emit(self.engine.on_message(m.topic, m.time, m.msg), m)
+
     def _handle(self, item: Any) -> None:
         if isinstance(item, Message):
             self._unqueue(item.size)
+            if self._applied and item.time <= self._applied.get(item.topic, float("-inf")):
+                return  # older than a newer message of its topic already handled (conflated)
             self._emit(self.engine.on_message(item.topic, item.time, item.msg), item)
         elif isinstance(item, NodeSample):
             self._emit(self.engine.on_node_sample(item.node, item.time, item.alive, item.cpu, item.memory), item)

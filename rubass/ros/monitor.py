@@ -217,7 +217,8 @@ class Monitor:
         was = self.overload.active
         if not was and self.overload.would_start(loop.dropped):  # written before the fail-safe runs
             self.keeper.save(loop.engine, self.dispatcher.orphans, self._fail_safes(starting=True))
-        self.overload.check(loop.dropped, now, self.dispatcher.runners, lambda name: loop.engine.spec.actions[name].latch)
+        self.overload.check(loop.dropped, now, self.dispatcher.runners, lambda name: loop.engine.spec.actions[name].latch,
+                            loop.dropped_by_topic)
         if was and not self.overload.active:
             self.keeper.save(loop.engine, self.dispatcher.orphans, self._fail_safes())
 

@@ -7,7 +7,7 @@ for `calm` seconds (a latched action stays until `~reset`). Checked on every eng
 """
 from __future__ import annotations
 
-from typing import Any, Callable, Dict, Sequence
+from typing import Any, Callable, Dict, Optional, Sequence
 
 from .actions.base import Context
 
@@ -23,14 +23,18 @@ class OverloadGuard:
         self._seen = 0  # drops already accounted for
         self._last_drop = 0.0
 
-    def check(self, dropped: int, now: float, runners: Dict[str, Any], latched: Callable[[str], bool]) -> None:
-        """On the engine's thread, at each tick: start on new drops, hold, release when calm."""
+    def check(self, dropped: int, now: float, runners: Dict[str, Any], latched: Callable[[str], bool],
+              by_topic: Optional[Dict[str, int]] = None) -> None:
+        """On the engine's thread, at each tick: start on new drops, hold, release when calm.
+        by_topic: messages dropped so far per topic, named in the log."""
         if dropped > self._seen:
             new, self._seen, self._last_drop = dropped - self._seen, dropped, now
+            what = _topics(by_topic)
             if not self.active and self.actions:
                 self.active = True
-                self.log("error", f"overloaded: {new} messages dropped (the engine's queue is full): running the "
-                                  f"fail-safe actions {', '.join(self.actions)} (~overload_actions)")
+                self.log("error", f"overloaded: {new} messages dropped (the engine's queue is full{what}; the newest "
+                                  f"message of each topic is kept and evaluated): running the fail-safe actions "
+                                  f"{', '.join(self.actions)} (~overload_actions)")
                 self._send("start", now, runners)
                 return
         if not self.active:
@@ -66,3 +70,11 @@ class OverloadGuard:
             self.report({"time": now, "event": kind, "behaviour": 0, "line": 0, "actions": self.actions,
                          "rules": ["monitor.overloaded"], "cause": "overload", "latency_ms": None})
 
+
+
+def _topics(by_topic: Optional[Dict[str, int]]) -> str:
+    """'; dropped so far: /scan 800, /odom 12' (the five topics that lost most)."""
+    if not by_topic:
+        return ""
+    top = sorted(by_topic.items(), key=lambda kv: -kv[1])[:5]
+    return "; dropped so far: " + ", ".join(f"{t} {n}" for t, n in top) + (", …" if len(by_topic) > 5 else "")

@@ -1,0 +1,66 @@
+"""Issue 13 (3): with the engine's queue full, the newest message of each topic is kept
+(conflation): a violation that arrives last after a burst of harmless messages is acted on."""
+import os
+
+from rubass.engine import Engine
+from rubass.engine.loop import EngineLoop, Message
+from rubass.lang import check_text
+
+from conftest import ROOT
+
+LIB = os.path.join(ROOT, "docs", "examples", "actions.yaml")
+
+
+class Clock:
+    def __init__(self):
+        self.t = 100.0
+
+    def __call__(self):
+        return self.t
+
+
+def make(body, max_queue=10):
+    spec = check_text("action primitive stop, warn;\n" + body, os.path.join(ROOT, "x.rbs"), [LIB])
+    got = []
+    clock = Clock()
+    loop = EngineLoop(Engine(spec, clock.t), clock, 50.0, lambda events, cause: got.extend(events),
+                      max_queue=max_queue)
+    return loop, clock, got
+
+
+def drain(loop, clock, steps=200):
+    for _ in range(steps):
+        clock.t += 0.0001
+        loop.step(max_wait=0)
+
+
+def test_a_violation_after_a_burst_that_overflows_the_queue_is_still_acted_on():
+    loop, clock, got = make("entity a { rules: r: topic /x.data > 1; }\nif (a.r) then { stop; }\n")
+    for i in range(100):  # the engine's thread is busy: nothing is taken from the queue
+        clock.t += 0.001
+        loop.submit(Message("/x", clock.t, {"data": 0.0}))
+    clock.t += 0.001
+    assert not loop.submit(Message("/x", clock.t, {"data": 5.0}))  # the violation, last, overflows
+    drain(loop, clock)
+    assert [e.kind for e in got if e.kind in ("start", "release")] == ["start"], got
+    assert loop.engine.rule_value("a.r") is True, "older queued messages did not overwrite the newest value"
+    assert loop.dropped == 91 and loop.dropped_by_topic == {"/x": 91}
+
+
+def test_the_newest_of_each_topic_is_kept_and_other_topics_are_untouched():
+    loop, clock, got = make("entity a { rules: r: topic /x.data > 1; q: topic /y.data > 1; }\n"
+                            "if (a.r) then { stop; }\nif (a.q) then { warn; }\n", max_queue=10)
+    for i in range(10):
+        clock.t += 0.001
+        loop.submit(Message("/x", clock.t, {"data": 0.0}))
+    for v in (7.0, 0.0, 9.0):  # /y overflows: only its newest (9) is kept
+        clock.t += 0.001
+        loop.submit(Message("/y", clock.t, {"data": v}))
+    drain(loop, clock)
+    assert loop.engine.rule_value("a.q") is True and loop.engine.rule_value("a.r") is False
+    assert loop.dropped_by_topic == {"/y": 3}
+    # once the queue has drained, normal order again: a later message of /y is not skipped
+    clock.t += 0.001
+    loop.submit(Message("/y", clock.t, {"data": 0.0}))
+    drain(loop, clock, 5)
+    assert loop.engine.rule_value("a.q") is False
