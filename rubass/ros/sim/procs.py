@@ -241,7 +241,7 @@ def reap(marker: str) -> None:
     """The reaper's main: follow 'add PGID SIG' / 'del PGID' on stdin; at end of input
     without 'bye' (the command died), stop every process with the marker: with its group's
     stop signal (SIGTERM when not told), then SIGKILL after GRACE seconds."""
-    for sig in SIGNALS:
+    for sig in (signal.SIGINT, signal.SIGHUP):
         signal.signal(sig, signal.SIG_IGN)  # a terminal's Ctrl-C or hangup is for the command
     groups: Dict[int, int] = {}
     for line in sys.stdin:
