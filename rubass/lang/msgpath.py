@@ -58,7 +58,8 @@ def resolve(registry: Registry, root: str, path: Sequence[PathElem], tables: Seq
         found = spec.get(elem)
         if found is None:
             at = owner if current is None else f"{where} ({owner})"
-            return FieldInfo("missing", why=f"{at} has no field '{elem}'{did_you_mean(elem, spec.names)} "
+            hint = _one_level_down(registry, spec.fields, done, elem) or did_you_mean(elem, spec.names)
+            return FieldInfo("missing", why=f"{at} has no field '{elem}'{hint} "
                                             f"(its fields: {', '.join(spec.names) or 'none'})")
         current, in_array = found, found.is_array
         done += (elem,)
@@ -75,19 +76,27 @@ def resolve(registry: Registry, root: str, path: Sequence[PathElem], tables: Seq
         if not found.is_primitive:
             anchors.append((found.type, []))
     if current is None:
-        return FieldInfo("msg", why=f"a {root} message is not a value: name one of its fields")
+        return FieldInfo("msg", why=f"it is a {root} (fields: {', '.join(_names(registry, root))})")
     if current.type in ("time", "duration"):
         dim = TIME
     if in_array:
-        return FieldInfo("array", dim, elem_kind="msg" if not current.is_primitive else _prim_kind(current.type))
+        return FieldInfo("array", dim, why=f"{current.type}[{current.length if current.length is not None else ''}]",
+                         elem_kind="msg" if not current.is_primitive else _prim_kind(current.type))
     if not current.is_primitive:
-        where = path_suffix(done).lstrip(".")
-        return FieldInfo("msg", why=f"'{where}' is a message ({current.type}), not a value: name one of its "
-                                    f"fields ({', '.join(_names(registry, current.type))})")
+        return FieldInfo("msg", why=f"it is a {current.type} (fields: {', '.join(_names(registry, current.type))})")
     kind = _prim_kind(current.type)
     if mapped:
         return FieldInfo("array", dim if kind == "num" else None, elem_kind=kind)
     return FieldInfo(kind, dim if kind == "num" else None)
+
+
+def _one_level_down(registry: Registry, fields: Sequence[FieldDef], done: Tuple[PathElem, ...], elem: str) -> str:
+    """"; did you mean 'twist.twist.linear'?" when a field of the message has the field asked for."""
+    for f in fields:
+        inner = registry.get(f.type) if not f.is_primitive and not f.is_array else None
+        if inner is not None and inner.get(elem) is not None:
+            return f"; did you mean '{path_suffix(done + (f.name, elem)).lstrip('.')}'?"
+    return ""
 
 
 def _names(registry: Registry, type_name: str) -> List[str]:

@@ -6,17 +6,14 @@ from __future__ import annotations
 import argparse
 import os
 import sys
-from typing import List, Optional, Tuple
+from typing import Optional, Tuple
 
-from ..lang.errors import Diagnostic
-from ..lang.libcheck import check_library_types, check_publish_topics, library_types
-from ..lang.model import CheckedSpec
 from ..lang.modelfile import dump_model, load_model
-from ..lang.msgdef import Registry
 from ..lang.source import SourceSet
-from ..lang.sysmodel import SystemModel, graph_warnings
+from ..lang.sysmodel import SystemModel
 from .bag import BagError
-from .model_sources import LiveError, add_installed, bag_model, live_model
+from .libtypes import after_check, try_installed
+from .model_sources import LiveError, bag_model, live_model
 
 
 def add_source_options(parser: argparse.ArgumentParser, for_check: bool) -> None:
@@ -53,36 +50,8 @@ def build_model(args: argparse.Namespace) -> Tuple[Optional[SystemModel], int]:
         return None, 1
     undefined = model.undefined_types()
     if undefined:  # a hand-written model: what is installed here fills the gaps
-        _try_installed(model.registry, undefined, ())
+        try_installed(model.registry, undefined, ())
     return model, 0
-
-
-def _try_installed(registry: Registry, msgs: List[str], srvs: List[str]) -> bool:
-    try:
-        add_installed(registry, msgs, srvs)
-        return True
-    except ImportError:  # no ROS Python here: only the model's own definitions
-        return False
-
-
-def after_check(checked: CheckedSpec, model: Optional[SystemModel]) -> Tuple[List[Diagnostic], List[Diagnostic]]:
-    """(errors, warnings) of the checks against the system: the spec's topics and nodes the
-    model lacks (warnings), and its action libraries against message definitions (errors)."""
-    warnings = graph_warnings(checked.spec, model) if model is not None else []
-    registry = Registry()
-    if model is not None:
-        for spec in model.registry.types.values():
-            registry.add(spec)
-    msgs, srvs = library_types(checked.actions)
-    installed = _try_installed(registry, msgs, srvs)
-    if not installed and model is None:
-        return [], warnings  # nothing to check against
-    where = " or ".join(([model.source] if model is not None else []) +
-                        (["the message packages installed here"] if installed else []))
-    errors = check_library_types(checked.actions, checked.sources, registry, where)
-    if model is not None:
-        errors += check_publish_topics(checked.actions, checked.sources, model.topics, model.source)
-    return errors, warnings
 
 
 def cmd_model(args: argparse.Namespace) -> int:

@@ -3,15 +3,17 @@ master, definitions of types not installed from the publishers' TCPROS handshake
 from /robot_description), and installed message and service definitions."""
 from __future__ import annotations
 
+import io
 import os
 import socket
 import xml.etree.ElementTree as ElementTree
-from typing import Dict, Iterable, Optional, Tuple
+from typing import Dict, Optional
 
-from ..lang.msgdef import DefinitionError, Registry, parse_full
+from ..lang.msgdef import DefinitionError, Registry
 from ..lang.std_units import joint_state_units
 from ..lang.sysmodel import SystemModel
 from .bag import BagError, open_bag
+from .libtypes import add_installed
 from .rpc import proxy as rpc_proxy
 
 CALLER = "/rubass_check"
@@ -19,35 +21,6 @@ CALLER = "/rubass_check"
 
 class LiveError(Exception):
     """The live graph cannot be read (no master, …); the message says why, in one line."""
-
-
-def add_installed(registry: Registry, msg_types: Iterable[str], srv_types: Iterable[str] = ()) -> None:
-    """Add the installed definitions of these message and service types (and what they use)."""
-    import roslib.message
-
-    for t in msg_types:
-        if registry.get(t) is not None:
-            continue
-        try:
-            cls = roslib.message.get_message_class(t)
-            if cls is not None:
-                registry.add_full(t, cls._full_text)
-        except Exception:  # not installed, a broken package, a bad name: unknown here
-            continue
-    for t in srv_types:
-        if t in registry.services:
-            continue
-        try:
-            cls = roslib.message.get_service_class(t)
-            if cls is None:
-                continue
-            req = parse_full(t + "Request", cls._request_class._full_text)
-            resp = parse_full(t + "Response", cls._response_class._full_text)
-        except Exception:
-            continue
-        for spec in list(req.values()) + list(resp.values()):
-            registry.add(spec)
-        registry.add_service(t, req[t + "Request"], resp[t + "Response"])
 
 
 def bag_model(path: str) -> SystemModel:
@@ -122,7 +95,7 @@ def _definition_from_publisher(master, topic: str, node: str, timeout: float) ->
             return None
         with socket.create_connection((proto[1], int(proto[2])), timeout=timeout) as sock:
             write_ros_handshake_header(sock, {"topic": topic, "md5sum": "*", "type": "*", "callerid": CALLER})
-            header = read_ros_handshake_header(sock, bytearray(), 65536)
+            header = read_ros_handshake_header(sock, io.BytesIO(), 65536)
     except Exception:  # a dead, hung or odd publisher: its type's fields stay unknown
         return None
     return header.get("message_definition") or None
@@ -136,10 +109,3 @@ def _joint_kinds(master) -> Dict[str, str]:  # type: ignore[no-untyped-def]
     except Exception:
         return {}
     return {j.get("name", ""): j.get("type", "") for j in root.iter("joint") if j.get("type") != "fixed"}
-
-
-def installed_registry(msg_types: Iterable[str], srv_types: Iterable[str] = ()) -> Tuple[Registry, str]:
-    """A registry of the installed definitions of these types, and where they were looked for."""
-    registry = Registry()
-    add_installed(registry, msg_types, srv_types)
-    return registry, "the message packages installed here"

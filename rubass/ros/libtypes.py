@@ -1,0 +1,70 @@
+"""Installed message and service definitions, and the checks a checked spec gets against the
+system after its own: action libraries against definitions, topics and nodes a model lacks.
+Light: the monitor runs these at start and at every reload."""
+from __future__ import annotations
+
+from typing import Iterable, List, Optional, Tuple
+
+from ..lang.errors import Diagnostic
+from ..lang.libcheck import check_library_types, check_publish_topics, library_types
+from ..lang.model import CheckedSpec
+from ..lang.msgdef import Registry, parse_full
+from ..lang.sysmodel import SystemModel, graph_warnings
+
+
+def add_installed(registry: Registry, msg_types: Iterable[str], srv_types: Iterable[str] = ()) -> None:
+    """Add the installed definitions of these message and service types (and what they use)."""
+    import roslib.message
+
+    for t in msg_types:
+        if registry.get(t) is not None:
+            continue
+        try:
+            cls = roslib.message.get_message_class(t)
+            if cls is not None:
+                registry.add_full(t, cls._full_text)
+        except Exception:  # not installed, a broken package, a bad name: unknown here
+            continue
+    for t in srv_types:
+        if t in registry.services:
+            continue
+        try:
+            cls = roslib.message.get_service_class(t)
+            if cls is None:
+                continue
+            req = parse_full(t + "Request", cls._request_class._full_text)
+            resp = parse_full(t + "Response", cls._response_class._full_text)
+        except Exception:
+            continue
+        for spec in list(req.values()) + list(resp.values()):
+            registry.add(spec)
+        registry.add_service(t, req[t + "Request"], resp[t + "Response"])
+
+
+def try_installed(registry: Registry, msgs: Iterable[str], srvs: Iterable[str]) -> bool:
+    """add_installed, when ROS Python is here; False when it is not."""
+    try:
+        add_installed(registry, msgs, srvs)
+        return True
+    except ImportError:  # no ROS Python here: only the model's own definitions
+        return False
+
+
+def after_check(checked: CheckedSpec, model: Optional[SystemModel]) -> Tuple[List[Diagnostic], List[Diagnostic]]:
+    """(errors, warnings) of the checks against the system: the spec's topics and nodes the
+    model lacks (warnings), and its action libraries against message definitions (errors)."""
+    warnings = graph_warnings(checked.spec, model) if model is not None else []
+    registry = Registry()
+    if model is not None:
+        for spec in model.registry.types.values():
+            registry.add(spec)
+    msgs, srvs = library_types(checked.actions)
+    installed = try_installed(registry, msgs, srvs)
+    if not installed and model is None:
+        return [], warnings  # nothing to check against
+    where = " or ".join(([model.source] if model is not None else []) +
+                        (["the message packages installed here"] if installed else []))
+    errors = check_library_types(checked.actions, checked.sources, registry, where)
+    if model is not None:
+        errors += check_publish_topics(checked.actions, checked.sources, model.topics, model.source)
+    return errors, warnings

@@ -1,0 +1,121 @@
+"""`rubass check --live` and `rubass model --live` against a private master with real publishers,
+one of a message type installed nowhere (its definition comes from the publisher's handshake)."""
+import os
+import subprocess
+import sys
+import time
+
+import pytest
+
+from conftest import ROOT
+
+pytestmark = pytest.mark.ros
+LIB = os.path.join(ROOT, "docs", "examples", "actions.yaml")
+
+PUBLISHER = r'''
+import rospy, genpy.dynamic
+from geometry_msgs.msg import Twist
+from sensor_msgs.msg import JointState
+PACK = """Header header
+float32 pack_voltage
+acme_msgs/Cell[] cells
+================================================================================
+MSG: std_msgs/Header
+uint32 seq
+time stamp
+string frame_id
+================================================================================
+MSG: acme_msgs/Cell
+float32 voltage
+float32 temp
+"""
+Pack = genpy.dynamic.generate_dynamic("acme_msgs/Pack", PACK)["acme_msgs/Pack"]
+rospy.init_node("driver")
+pubs = [(rospy.Publisher("/cmd_vel", Twist, queue_size=1), Twist()),
+        (rospy.Publisher("/acme/pack", Pack, queue_size=1), Pack()),
+        (rospy.Publisher("/joint_states", JointState, queue_size=1), JointState(name=["l", "r"]))]
+rospy.Subscriber("/odom_filtered", Twist, lambda m: None)
+print("ready", flush=True)
+while not rospy.is_shutdown():
+    for pub, msg in pubs:
+        pub.publish(msg)
+    rospy.sleep(0.1)
+'''
+URDF = """<robot name="r"><link name="base"/><link name="wl"/><link name="wr"/><link name="laser"/>
+<joint name="l" type="continuous"><parent link="base"/><child link="wl"/></joint>
+<joint name="r" type="continuous"><parent link="base"/><child link="wr"/></joint>
+<joint name="laser_mount" type="fixed"><parent link="base"/><child link="laser"/></joint></robot>"""
+
+
+@pytest.fixture
+def graph(ros, tmp_path):
+    import rosgraph
+
+    master = rosgraph.Master("/test", master_uri=ros.master.uri)
+    master.setParam("/robot_description", URDF)
+    script = tmp_path / "publisher.py"
+    script.write_text(PUBLISHER)
+    proc = ros.spawn(["/usr/bin/python3", str(script)], "publisher")
+    end = time.time() + 30
+    while time.time() < end:
+        if proc.poll() is not None:
+            raise AssertionError(ros.log(proc))
+        if {"/cmd_vel", "/acme/pack", "/joint_states"} <= {t for t, _ in master.getTopicTypes()}:
+            return ros
+        time.sleep(0.1)
+    raise AssertionError("the publisher never advertised")
+
+
+def rubass(ros, *args):
+    proc = subprocess.run([sys.executable, "-m", "rubass", *args], cwd=ROOT, capture_output=True, text=True,
+                          timeout=120, env=ros.env)
+    return proc.returncode, proc.stdout, proc.stderr
+
+
+def test_live_model_reads_types_nodes_foreign_definitions_and_joint_kinds(graph):
+    from rubass.lang.units import dim
+    from rubass.ros.model_sources import live_model
+
+    m = live_model(graph.master.uri)
+    assert m.type_of("/acme/pack") == "acme_msgs/Pack"
+    assert "/driver" in m.nodes
+    assert m.undefined_types() == []  # acme_msgs is installed nowhere: read from the handshake
+    assert m.field("/acme/pack", ("cells", 0, "temp")).kind == "num"
+    assert "did you mean 'pack_voltage'" in m.field("/acme/pack", ("voltage",)).why
+    assert m.field("/joint_states", ("velocity", 0)).dim == dim(rad=1, s=-1)  # both joints continuous
+    assert m.field("/cmd_vel", ("linear", "x")).dim == dim(m=1, s=-1)
+
+
+def test_check_live_warns_of_unknown_topics_and_nodes(graph, write):
+    path = write("s.rbs", f'import "{LIB}";\naction primitive stop;\n'
+                          "entity base: drivr {\n  rules:\n    r: topic /cmd_vl.linear.x > 1 m/s;\n"
+                          "    hot: cpu(node drivr) > 50 %;\n}\nif (base.r) then { stop; }\n")
+    code, out, err = rubass(graph, "check", "--live", path)
+    assert code == 0, err
+    assert f"{path}:3:14: warning: node 'drivr' is not in the live graph at {graph.master.uri}; " \
+           "did you mean '/driver'?" in err
+    assert f"{path}:5:8: warning: topic '/cmd_vl' is not in the live graph" in err
+    assert "did you mean '/cmd_vel'?" in err
+
+
+def test_model_live_then_check_with_no_master(graph, write, tmp_path):
+    out_file = str(tmp_path / "robot.yaml")
+    code, _, err = rubass(graph, "model", "--live", "-o", out_file)
+    assert code == 0, err
+    text = open(out_file).read()
+    assert "/acme/pack: acme_msgs/Pack" in text and "acme_msgs/Cell: |" in text
+    assert "    type: sensor_msgs/JointState\n    units:\n      position: rad\n      velocity: rad/s" in text
+    assert "- /driver" in text
+    graph.stop()  # no ROS running from here on
+    path = write("s.rbs", f'import "{LIB}";\naction primitive stop;\n'
+                          "entity base: driver {\n  rules:\n    r: topic /acme/pack.pack_voltage > 3 V;\n}\n"
+                          "if (base.r) then { stop; }\n")
+    code, out, err = rubass(graph, "check", "--model", out_file, path)
+    assert code == 0 and "warning" not in err, err
+
+
+def test_no_master_is_a_clear_error(ros, write):
+    path = write("s.rbs", f'import "{LIB}";\naction primitive stop;\n'
+                          "entity e { rules: r: topic /x.data > 1; }\nif (e.r) then { stop; }\n")
+    code, _, err = rubass(ros, "check", "--live", "--master", "http://127.0.0.1:9", path)
+    assert code == 2 and "no ROS master at http://127.0.0.1:9" in err and "Traceback" not in err
