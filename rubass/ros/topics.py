@@ -30,6 +30,7 @@ class TopicState:
     spec_name: str
     resolved: str
     paths: Dict[Tuple[ast.PathElem, ...], List[str]]  # field path -> rules reading it
+    aliases: Tuple[str, ...] = ()  # other spellings of this topic in the spec ('cmd_vel' beside '/cmd_vel')
     type: str = ""
     md5: str = ""
     messages: int = 0
@@ -48,8 +49,20 @@ class TopicWatcher:
 
     def sync(self, spec: CheckedSpec) -> None:
         """Subscribe to the spec's topics, unsubscribe from those it no longer names."""
-        wanted = {rospy.resolve_name(t): t for t in spec.topics}
-        users = spec.field_readers()
+        # relative, absolute and ~private names resolve once, by ROS rules, to one subscription:
+        # every spelling of a topic in the spec gets the same messages (one value, not two topics)
+        spellings: Dict[str, List[str]] = {}
+        for t in sorted(spec.topics, key=lambda t: (not spec.topics[t].paths, t)):  # a reader of fields first
+            spellings.setdefault(rospy.resolve_name(t), []).append(t)
+        wanted = {r: names[0] for r, names in spellings.items()}
+        readers = spec.field_readers()
+        users: Dict[str, Dict[Tuple[ast.PathElem, ...], List[str]]] = {}
+        for names in spellings.values():
+            merged: Dict[Tuple[ast.PathElem, ...], List[str]] = {}
+            for n in names:
+                for path, owners in readers[n].items():
+                    merged.setdefault(path, []).extend(o for o in owners if o not in merged.get(path, []))
+            users[names[0]] = merged
         with self._lock:
             for resolved in [r for r in self.topics if r not in wanted]:
                 state = self.topics.pop(resolved)
@@ -57,13 +70,14 @@ class TopicWatcher:
                     state.subscriber.unregister()
             for resolved, name in wanted.items():
                 state = self.topics.get(resolved)
+                aliases = tuple(spellings[resolved][1:])
                 if state is None:
-                    state = TopicState(name, resolved, users[name])
+                    state = TopicState(name, resolved, users[name], aliases)
                     self.topics[resolved] = state
                     state.subscriber = rospy.Subscriber(resolved, rospy.AnyMsg, self._callback,
                                                         callback_args=state, tcp_nodelay=True)
                 else:
-                    state.spec_name, state.paths = name, users[name]
+                    state.spec_name, state.paths, state.aliases = name, users[name], aliases
                     if state.cls is not None:
                         state.errors = self._check(state)
 
@@ -80,13 +94,16 @@ class TopicWatcher:
         state.messages += 1
         if not state.paths:
             self.submit(state.spec_name, now, None, wall, 0)  # age/frequency only: never deserialised
+            for alias in state.aliases:
+                self.submit(alias, now, None, wall, 0)
             return
         header = getattr(raw, "_connection_header", None) or {}
         md5 = header.get("md5sum", "")
         if md5 != state.md5:
             self._new_type(state, header)
         if state.cls is None:
-            self.submit(state.spec_name, now, UNKNOWN, wall, 0)
+            for name in (state.spec_name,) + state.aliases:
+                self.submit(name, now, UNKNOWN, wall, 0)
             return
         try:
             msg = state.cls().deserialize(raw._buff)
@@ -96,6 +113,8 @@ class TopicWatcher:
                 self.log("error", f"topic {state.resolved}: {state.errors[-1]}")
             msg = UNKNOWN
         self.submit(state.spec_name, now, msg, wall, len(raw._buff) if msg is not UNKNOWN else 0)
+        for alias in state.aliases:  # the same message, under the spec's other spelling of the topic
+            self.submit(alias, now, msg, wall, 0)
 
     def _new_type(self, state: TopicState, header: Dict[str, str]) -> None:
         old = state.type
