@@ -8,6 +8,7 @@ RUBASS_APT_PACKAGES=(
   python3-std-msgs python3-geometry-msgs python3-nav-msgs python3-sensor-msgs python3-std-srvs
   python3-diagnostic-msgs python3-pyparsing python3-psutil python3-serial python3-yaml
   python3-matplotlib python3-pytest python3-hypothesis python3-venv python3-pip socat make
+  iproute2  # ip netns: the multi-host tests (test/integration/test_multihost.py)
   g++  # catkin_make: CMake's project() needs a C/C++ compiler, which cmake only recommends
 )
 

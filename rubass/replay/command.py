@@ -2,8 +2,9 @@
 from __future__ import annotations
 
 import argparse
+import json
 import sys
-from typing import Set
+from typing import Any, Iterable, Set, Tuple
 
 from ..lang import SpecError, load_spec
 from . import report
@@ -37,6 +38,17 @@ def _global(name: str) -> str:
     return name if name.startswith("/") else "/" + name.lstrip("~")
 
 
+def _sampled_nodes(samples: Iterable[Tuple[float, str, Any]]) -> Set[str]:
+    """The nodes that a monitor's recorded ~node_samples cover."""
+    out: Set[str] = set()
+    for _, _, msg in samples:
+        try:
+            out.add(str(json.loads(msg.data)["node"]))
+        except (ValueError, KeyError, TypeError, AttributeError):
+            continue
+    return out
+
+
 def run(args: argparse.Namespace) -> int:
     try:
         spec = load_spec(args.spec, args.actions)
@@ -58,9 +70,11 @@ def run(args: argparse.Namespace) -> int:
                 print(f"rubass replay: warning: topic {name} is not in {args.bag}; its values stay unknown",
                       file=sys.stderr)
         node_topics = sorted(t for t, ty in info.types.items() if t.endswith("/node_samples") and ty == "std_msgs/String")
-        if spec.nodes and not node_topics:
-            print("rubass replay: warning: the recording has no node samples (a monitor's ~node_samples); "
-                  "alive(), cpu() and memory() stay unknown", file=sys.stderr)
+        agent_topics = sorted(t for t, ty in info.types.items()
+                              if t.endswith("/agent_samples") and ty == "std_msgs/String")
+        if spec.nodes and not node_topics and not agent_topics:
+            print("rubass replay: warning: the recording has no node samples (a monitor's ~node_samples or the "
+                  "agents' /rubass/agent_samples); alive(), cpu() and memory() stay unknown", file=sys.stderr)
         present = [t for t in topic_map if t in info.types]
         decode: Set[str] = {t for t in present if spec.topics[topic_map[t]].needs_data}
         classes = message_classes(bag, sorted(decode))
@@ -79,8 +93,20 @@ def run(args: argparse.Namespace) -> int:
         from .run import replay
 
         node_topics = node_topics if spec.nodes else []
+        agent_topics = agent_topics if spec.nodes else []
         stream = ((t, topic_map.get(topic, topic), msg)
-                  for t, topic, msg in read(bag, present + node_topics, decode | set(node_topics)))
+                  for t, topic, msg in read(bag, present + node_topics + agent_topics,
+                                            decode | set(node_topics) | set(agent_topics)))
+        if agent_topics:  # multi-host: the agents' reports, for the nodes the monitor's samples do not cover
+            from .agents import SAMPLES, agent_samples
+
+            try:
+                skip = _sampled_nodes(read(bag, node_topics, set(node_topics)))
+            except BagError as exc:
+                print(f"rubass replay: error: {exc}", file=sys.stderr)
+                return 1
+            stream = agent_samples(stream, set(agent_topics), {_global(n): n for n in spec.nodes}, skip, info.end)
+            node_topics = node_topics + [SAMPLES]
         try:
             _, events = replay(spec, stream, info.start, info.end, args.rate, node_topics)
         except BagError as exc:

@@ -16,6 +16,8 @@ Parameters (private)
                                   $ROS_HOME/rubass/NODE.latches.json; false: off)
 Subscribes
     every topic the spec names, whatever its type (rospy.AnyMsg, tcp_nodelay)
+    /rubass/agent_samples (std_msgs/String)  the agents' reports: cpu and memory of nodes on
+                                  other hosts (docs/multihost.md)
 Publishes
     /diagnostics (diagnostic_msgs/DiagnosticArray)  one status per entity, one for the monitor
     ~events (std_msgs/String)     one JSON object per behaviour start and release (docs/monitor.md)
@@ -39,6 +41,7 @@ from typing import Any, Dict, List, Optional, Tuple
 
 import rosgraph
 import rospy
+from std_msgs.msg import String
 from std_srvs.srv import Trigger, TriggerResponse
 
 from ..engine import Engine
@@ -47,6 +50,8 @@ from ..lang import SpecError, load_spec
 from ..lang.model import CheckedSpec
 from . import status as status_mod
 from .actions.base import ActionSetupError, make_plugin
+from .agentbook import AGENT_TOPIC, AgentBook
+from .agentbook import decode as decode_agent_report
 from .actions.runner import ActionRunner
 from .dispatch import Dispatcher
 from .master_watch import MasterWatch
@@ -189,6 +194,8 @@ class Monitor:
         self.keeper.save(engine, self.dispatcher.orphans, self._fail_safes())
         self.watcher = TopicWatcher(self._on_message, _log)
         self.watcher.sync(spec)
+        self.agents = AgentBook()  # cpu and memory of nodes on other hosts, from their agents
+        self._agent_sub = rospy.Subscriber(AGENT_TOPIC, String, self._on_agent, queue_size=100, tcp_nodelay=True)
         self.sampler = self._sampler(spec)
         self.load_error = ""
         rospy.loginfo("rubass: enforcing %s (%d rules, %d behaviours, %d topics, %d nodes)", spec.path,
@@ -225,11 +232,18 @@ class Monitor:
     def _sampler(self, spec: CheckedSpec) -> NodeSampler:
         nodes = [(n, rospy.resolve_name(n)) for n in sorted(spec.nodes)]
         sampler = NodeSampler(nodes, self._on_node, _ros_now, 1.0 / self.config.node_rate, rospy.get_name())
+        sampler.remote = lambda node, host, pid: self.agents.lookup(node, host, pid, time.monotonic())
         sampler.start()
         return sampler
 
     def _on_message(self, topic: str, now: float, msg: Any, wall: float, size: int) -> None:
         self.loop.submit(Message(topic, now, msg, wall, size))
+
+    def _on_agent(self, msg: String) -> None:
+        try:
+            self.agents.update(decode_agent_report(msg.data), time.monotonic())
+        except ValueError as exc:
+            rospy.logwarn_throttle(10, f"rubass: ignoring a bad report on {AGENT_TOPIC}: {exc}")
 
     def _on_node(self, node: str, now: float, alive: Any, cpu: Any, memory: Any) -> None:
         self.loop.submit(NodeSample(node, now, alive, cpu, memory))
@@ -401,6 +415,8 @@ class Monitor:
             "action failures": failures,
             "master": self.master_watch.state, "master re-registrations": self.master_watch.reregistrations,
             "reaction latency p50 ms": f"{lat[len(lat) // 2] * 1000:.3f}" if lat else "n/a",
+            "agents": self.agents.summary(time.monotonic()),
+            "silent agents": ", ".join(self.agents.silent(time.monotonic())) or "none",
         }
         for name, r in self.runners.items():
             if r.stats.last_error:

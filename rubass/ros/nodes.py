@@ -22,6 +22,7 @@ from ..engine.values import UNKNOWN
 from . import rpc
 
 Submit = Callable[[str, float, Any, Any, Any], None]  # (spec node, ROS time, alive, cpu, memory)
+Remote = Callable[[str, str, int], Tuple[Any, Any, str]]  # (resolved node, host, pid) -> (cpu, memory, why)
 
 
 def _schedstat_seconds(pid: int) -> Optional[float]:
@@ -65,6 +66,7 @@ class NodeSampler:
         self.status: Dict[str, NodeStatus] = {r: NodeStatus(n, r) for n, r in nodes}
         self.submit, self.now, self.period, self.timeout = submit, now, period, timeout
         self.caller_id = caller_id
+        self.remote: Optional[Remote] = None  # cpu and memory of nodes on other hosts (the monitor's agents)
         self.master_uri = rosgraph.get_master_uri()
         self._procs: Dict[int, psutil.Process] = {}
         self._cpu_last: Dict[int, Tuple[float, float]] = {}
@@ -108,6 +110,8 @@ class NodeSampler:
                 note = why[len("alive"):]
                 cpu, memory, why = self._measure(pid)
                 why += note
+            elif self.remote is not None:
+                cpu, memory, why = self.remote(st.resolved, urlparse(uri).hostname or "", pid)
             else:
                 why = f"on host {urlparse(uri).hostname}, not this one: cpu and memory are unknown"
         st.alive, st.cpu, st.memory, st.pid, st.why = alive, cpu, memory, pid, why

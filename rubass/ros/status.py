@@ -92,6 +92,9 @@ def build(spec: CheckedSpec, rules: Dict[str, Any], active: List[int], topics: D
     if str(monitor.get("master", "connected")) != "connected":
         level = max(level, WARN)
         msg += f" (master {monitor['master']})"
+    if monitor.get("silent agents", "none") not in ("none", ""):  # cpu/memory of that host's nodes unknown
+        level = max(level, WARN)
+        msg += f" (agent silent: {monitor['silent agents']})"
     if monitor.get("last reload error"):
         msg += " (the last reload was rejected; the previous rules still run)"
     msg += msg_latch

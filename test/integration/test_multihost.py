@@ -1,0 +1,221 @@
+"""A robot with several computers, for real: network namespaces as hosts (netns.py).
+
+Hosts: `robot` (the master and the base's driver), `arm` (a second robot computer) and
+`safety` (the monitor, on its own host as the paper proposes); an agent on each. Needs root
+and iproute2; skipped with the reason otherwise.
+"""
+import json
+import os
+import signal
+import subprocess
+import time
+
+import pytest
+
+from conftest import ROOT
+
+pytestmark = [pytest.mark.ros, pytest.mark.slow]
+
+PY = "/usr/bin/python3"
+NODE = os.path.join(ROOT, "test", "integration", "multihost_node.py")
+LIB = """actions:
+  stop: {plugin: publish, topic: /safety_cmd, type: geometry_msgs/Twist, message: {}, rate: 20 Hz, latch: true}
+  warn: {plugin: log, level: warn}
+"""
+HOSTS = ["robot", "arm", "safety"]
+
+
+class Cluster:
+    """Processes on the hosts of a Network, with the master on `robot`."""
+
+    def __init__(self, net, tmp):
+        self.net, self.tmp, self.procs = net, tmp, []
+        self.master_uri = f"http://{net.address['robot']}:11311"
+
+    def env(self, host):
+        env = dict(os.environ, ROS_MASTER_URI=self.master_uri, ROS_IP=self.net.address[host],
+                   ROS_HOME=str(self.tmp / f"home-{host}"), ROS_LOG_DIR=str(self.tmp / f"log-{host}"),
+                   PYTHONPATH=ROOT + os.pathsep + os.environ.get("PYTHONPATH", ""), PYTHONUNBUFFERED="1",
+                   PYTHONDONTWRITEBYTECODE="1")
+        env.pop("ROS_HOSTNAME", None)
+        return env
+
+    def spawn(self, host, args, name):
+        log = self.tmp / f"{name}.log"
+        proc = subprocess.Popen(self.net.cmd(host, args), env=self.env(host), stdout=open(log, "w"),
+                                stderr=subprocess.STDOUT, cwd=str(self.tmp), start_new_session=True)
+        proc.log_path = log
+        self.procs.append(proc)
+        return proc
+
+    def run(self, host, code, timeout=30):
+        """Python code run on `host` to completion (e.g. to wait for something there)."""
+        return subprocess.run(self.net.cmd(host, [PY, "-c", code]), env=self.env(host), capture_output=True,
+                              text=True, timeout=timeout)
+
+    def start_master(self):
+        self.spawn("robot", ["rosmaster", "--core", "-p", "11311"], "master")
+        out = self.run("robot", "import rosgraph, time\nend = time.time() + 15\n"
+                                f"while not rosgraph.is_master_online('{self.master_uri}') and time.time() < end:\n"
+                                "    time.sleep(0.05)\n"
+                                f"assert rosgraph.is_master_online('{self.master_uri}'), 'master not online'\n")
+        assert out.returncode == 0, out.stderr
+
+    def agent(self, host):
+        return self.spawn(host, [PY, os.path.join(ROOT, "scripts", "agent"), "_node_rate:=10"], f"agent-{host}")
+
+    def node(self, host, name, *args):
+        return self.spawn(host, [PY, NODE, *args, f"__name:={name}"], name)
+
+    def monitor(self, spec):
+        return self.spawn("safety", [PY, os.path.join(ROOT, "scripts", "monitor"), "__name:=rubass",
+                                     f"_spec:={spec}", "_diagnostics_rate:=5"], "monitor")
+
+    def listen(self, host, name, *topics):
+        out = self.tmp / f"{name}.jsonl"
+        out.touch()
+        self.node(host, name, "listen", str(out), *topics)
+        return out
+
+    @staticmethod
+    def log(proc):
+        return open(proc.log_path).read() if os.path.exists(proc.log_path) else ""
+
+    def logs(self):
+        return "\n".join(f"--- {p.args[3:6]}\n{self.log(p)[-1500:]}" for p in self.procs)
+
+    def stop(self):
+        from rubass.ros.master import stop_processes
+
+        for host in list(self.net.cut_hosts):  # nodes unregister from the master as they stop
+            self.net.mend(host)
+        stop_processes(list(reversed(self.procs)))
+
+
+@pytest.fixture
+def cluster(tmp_path):
+    if not os.path.exists("/usr/bin/rosmaster"):
+        pytest.skip("ROS 1 is not installed (rosmaster)")
+    from netns import Network
+
+    why = Network.check()
+    if why:
+        pytest.skip(f"multi-host tests need network namespaces: {why}")
+    net = Network(HOSTS)
+    net.setup()
+    c = Cluster(net, tmp_path)
+    try:
+        c.start_master()
+        yield c
+    finally:
+        try:
+            c.stop()
+        finally:
+            net.close()
+    assert net.leftovers() == [], "namespaces left behind"
+
+
+def write_spec(tmp_path, body):
+    (tmp_path / "lib.yaml").write_text(LIB)
+    path = tmp_path / "safety.rbs"
+    path.write_text('import "lib.yaml";\naction primitive stop, warn;\n' + body)
+    return str(path)
+
+
+def lines(path):
+    out = []
+    for line in open(path).read().splitlines():
+        try:
+            out.append(json.loads(line))
+        except ValueError:
+            pass  # a line being written
+    return out
+
+
+def wait_for(cluster, what, test, timeout=30.0):
+    end = time.time() + timeout
+    while time.time() < end:
+        found = test()
+        if found:
+            return found
+        time.sleep(0.1)
+    raise AssertionError(f"{what} within {timeout:g} s\n{cluster.logs()}")
+
+
+def statuses(path, name):
+    """Every /diagnostics status named `name`, oldest first: (wall, message, values)."""
+    out = []
+    for rec in lines(path):
+        if rec["topic"] == "/diagnostics":
+            for st in rec["msg"]["status"]:
+                if st["name"] == name:
+                    out.append((rec["wall"], st["message"], {kv["key"]: kv["value"] for kv in st["values"]}))
+    return out
+
+
+def events(path):
+    return [dict(json.loads(r["msg"]["data"]), wall=r["wall"]) for r in lines(path) if r["topic"] == "/rubass/events"]
+
+
+def start_everywhere(cluster, spec, *robot_nodes):
+    """Agents on every host, the robot's nodes, the monitor and its listener on `safety`."""
+    for host in HOSTS:
+        cluster.agent(host)
+    for host, name, *args in robot_nodes:
+        cluster.node(host, name, *args)
+    watch = cluster.listen("safety", "watch", "/diagnostics:diagnostic_msgs/DiagnosticArray",
+                           "/rubass/events:std_msgs/String")
+    cluster.monitor(spec)
+    return watch
+
+
+def test_a_cpu_hog_on_another_host_is_measured_by_its_agent_and_stopped(cluster, tmp_path):
+    spec = write_spec(tmp_path, "entity arm: hog { rules: busy: (cpu(node hog) > 30 %) for 1 s; }\n"
+                                "if (arm.busy) then { stop; }\n")
+    stops = cluster.listen("arm", "arm_listener", "/safety_cmd:geometry_msgs/Twist")
+    watch = start_everywhere(cluster, spec, ("arm", "hog", "hog"))
+    wait_for(cluster, "the stop reached the arm's host", lambda: lines(stops), timeout=40)
+    start = wait_for(cluster, "a start event", lambda: [e for e in events(watch) if e["event"] == "start"])[0]
+    assert start["rules"] == ["arm.busy"] and start["actions"] == ["stop"]
+    assert start["cause"] in ("deadline", "node sample of hog")
+
+
+def test_a_killed_agent_makes_its_hosts_rules_unknown_and_the_status_names_it(cluster, tmp_path):
+    spec = write_spec(tmp_path, "entity arm: calm { rules: busy: cpu(node calm) > 95 %; }\n"
+                                "if (arm.busy) then { warn(\"busy\"); }\n")
+    watch = start_everywhere(cluster, spec, ("arm", "calm", "talk", "/arm_state", "5"))
+    wait_for(cluster, "arm's rule known (false) from its agent",
+             lambda: [s for s in statuses(watch, "rubass: arm") if s[1] == "all rules false"], timeout=40)
+    agent = next(p for p in cluster.procs if p.log_path.name == "agent-arm.log")
+    os.killpg(agent.pid, signal.SIGKILL)
+    killed = time.time()
+    silent = wait_for(cluster, "the arm's rule unknown because its agent is silent",
+                      lambda: [s for s in statuses(watch, "rubass: arm") if s[0] > killed and s[1] == "unknown: busy"])
+    why = silent[-1][2]["busy unknown because"]
+    arm = cluster.net.address["arm"]
+    assert f"agent /rubass_agent_{arm.replace('.', '_')} on host {arm} is silent" in why, why
+    mon = wait_for(cluster, "the monitor's status names the silent agent",
+                   lambda: [s for s in statuses(watch, "rubass: monitor") if "agent silent" in s[1]])
+    assert f"/rubass_agent_{arm.replace('.', '_')} on {arm}" in mon[-1][1]
+    # the other hosts' agents still report
+    assert "rubass_agent_10_200_0_1 on 10.200.0.1: ok" in mon[-1][2]["agents"]
+
+
+def test_a_cut_link_fires_the_age_and_alive_rules_as_written(cluster, tmp_path):
+    spec = write_spec(tmp_path, "entity base: driver { rules: stale: age(topic /odom) > 1 s;\n"
+                                "  gone: not alive(node driver); }\n"
+                                "if (base.stale) then { warn(\"odometry stale\"); }\n"
+                                "if (base.gone) then { warn(\"driver gone\"); }\n")
+    watch = start_everywhere(cluster, spec, ("robot", "driver", "talk", "/odom", "20"))
+    wait_for(cluster, "the base's rules false",
+             lambda: [s for s in statuses(watch, "rubass: base") if s[1] == "all rules false"], timeout=40)
+    cluster.net.cut("robot")
+    cut = time.time()
+    started = wait_for(cluster, "both behaviours started",
+                       lambda: (lambda ev: ev if {1, 2} <= {e["behaviour"] for e in ev} else None)(
+                           [e for e in events(watch) if e["event"] == "start" and e["wall"] > cut]))
+    first = {e["behaviour"]: e for e in reversed(started)}
+    assert first[1]["rules"] == ["base.stale"] and first[2]["rules"] == ["base.gone"]
+    # age > 1 s fires no sooner than a second after the last message came, i.e. after the cut
+    assert first[1]["wall"] - cut > 0.9
+    assert first[2]["wall"] - cut < 10
