@@ -4,6 +4,12 @@
 # paper's 10: about 3 minutes), prints the table beside the paper's figures and names the plot.
 # For the full run: /usr/bin/python3 -m rubass experiments --reps 10
 set -euo pipefail
+# A signal before the experiments start ends the demo with 128 + the signal once the running step
+# returns (apt/dpkg is never cut short). The experiments are exec'd, so they receive the signals
+# sent to this script themselves, and stop every process they started (docs/experiments.md).
+trap 'exit 130' INT
+trap 'exit 143' TERM
+trap 'exit 129' HUP
 cd "$(dirname "$0")/.."
 source tools/deps.sh
 rubass_install_deps
