@@ -8,7 +8,11 @@ from typing import List, Optional, Sequence
 
 from .lang import SpecError, format_spec, load_spec, parse_source
 from .replay.command import register as register_replay
+from .testing.command import register as register_test
+from .report.command import register as register_report
 from .ros.sim.command import register as register_experiments
+from .ros.model_command import add_source_options, after_check, build_model
+from .ros.model_command import register as register_model
 from .lang.errors import Diagnostic
 from .lang.source import SourceSet
 from .lang.sourcefile import read_source
@@ -21,17 +25,25 @@ def _print_diags(diags: Sequence[Diagnostic], sources: Optional[SourceSet]) -> N
 
 def cmd_check(args: argparse.Namespace) -> int:
     """Check each spec; all errors of all files are printed."""
-    status = 0
+    model, status = build_model(args)  # --bag, --live, --model: a system model to check against
+    if status:
+        return status
     for path in args.spec:
         try:
-            checked = load_spec(path, args.actions)
+            checked = load_spec(path, args.actions, model=model)
         except SpecError as exc:
             print(exc.render(), file=sys.stderr)
             n = sum(d.severity == "error" for d in exc.diagnostics)
             print(f"{path}: {n} error{'s' if n != 1 else ''}", file=sys.stderr)
             status = 1
             continue
-        _print_diags(checked.warnings, checked.sources)
+        errors, warnings = after_check(checked, model)
+        _print_diags(checked.warnings + warnings, checked.sources)
+        if errors:
+            _print_diags(errors, checked.sources)
+            print(f"{path}: {len(errors)} error{'s' if len(errors) != 1 else ''}", file=sys.stderr)
+            status = 1
+            continue
         if not args.quiet:
             print(f"{path}: ok ({len(checked.rules)} rules, {len(checked.behaviours)} behaviours, "
                   f"{len(checked.topics)} topics, {len(checked.nodes)} nodes, {len(checked.actions)} actions)")
@@ -75,6 +87,7 @@ def _parser() -> argparse.ArgumentParser:
     c.add_argument("--actions", action="append", default=[], metavar="LIB.yaml",
                    help="an action library to load besides the spec's imports (repeatable)")
     c.add_argument("-q", "--quiet", action="store_true", help="print nothing when clean")
+    add_source_options(c, for_check=True)
     c.set_defaults(func=cmd_check)
     f = sub.add_parser("fmt", help="print a spec in canonical layout")
     f.add_argument("spec", metavar="SPEC")
@@ -83,7 +96,10 @@ def _parser() -> argparse.ArgumentParser:
     g.add_argument("--write", action="store_true", help="rewrite the file in place")
     f.set_defaults(func=cmd_fmt)
     register_replay(sub)
+    register_test(sub)
+    register_report(sub)
     register_experiments(sub)
+    register_model(sub)
     return p
 
 

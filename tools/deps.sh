@@ -10,6 +10,7 @@ RUBASS_APT_PACKAGES=(
   python3-matplotlib python3-pytest python3-hypothesis python3-venv python3-pip socat make
   iproute2  # ip netns: the multi-host tests (test/integration/test_multihost.py)
   g++  # catkin_make: CMake's project() needs a C/C++ compiler, which cmake only recommends
+  chromium  # rubass report: the report is rendered in headless Chromium by a slow test (and for docs/)
 )
 
 rubass_install_deps() {

@@ -147,7 +147,7 @@ class _Reader:
             if c.name in seen:
                 raise self.fail(c.line, f"a second test named '{c.name}' (the first is at line {seen[c.name]})")
             seen[c.name] = c.line
-        return TestFile(self.path, os.path.join(base, spec), top.at("spec"), actions, cases)
+        return TestFile(self.path, os.path.normpath(os.path.join(base, spec)), top.at("spec"), actions, cases)
 
     def case(self, value: Any, line: int, i: int) -> Case:
         t = self.mapping(value, line, "a test", ("name", "covers", "duration", "topics", "nodes", "expect",

@@ -1,0 +1,76 @@
+"""`rubass report SPEC [--tests FILE…] [--bag BAG…] [--hazards RISK.yaml] [--bench FILE] -o report.html`."""
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+
+from ..lang import SpecError, load_spec
+
+
+def register(sub: "argparse._SubParsersAction[argparse.ArgumentParser]") -> None:
+    p = sub.add_parser("report", help="write one self-contained HTML page of safety evidence",
+                       description="Write a report a certifier can read offline: rules with ids, hazards, titles "
+                                   "and refs; the hazard -> rule -> behaviour -> test matrix with gaps; test results; "
+                                   "each recording's timeline and events with their witnesses; the monitor's "
+                                   "measured reaction. Exit 0 written, 1 a test fails or an input is bad, 2 usage.")
+    p.add_argument("spec", metavar="SPEC")
+    p.add_argument("--tests", nargs="+", default=[], metavar="FILE.test.yaml", help="rule test files to run")
+    p.add_argument("--bag", nargs="+", default=[], metavar="BAG", help="recordings to replay")
+    p.add_argument("--hazards", metavar="RISK.yaml", help="the risk-assessment table (hazards: [{id, title, …}])")
+    p.add_argument("--bench", metavar="FILE", help="bench/reaction.py JSON lines (default: bench/README.md figures)")
+    p.add_argument("--actions", action="append", default=[], metavar="LIB.yaml",
+                   help="an action library to load besides the spec's imports (repeatable)")
+    p.add_argument("-o", "--output", required=True, metavar="report.html")
+    p.set_defaults(func=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    from ..testing.results import run_file
+    from .bench import measured
+    from .evidence import Evidence, ReportError, build_matrix, read_hazards, replay_bag
+    from .html import render
+
+    try:
+        spec = load_spec(args.spec, args.actions)
+    except SpecError as exc:
+        print(exc.render(), file=sys.stderr)
+        return 1
+    try:
+        hazards = read_hazards(args.hazards) if args.hazards else []
+        reaction = measured(args.bench)
+    except ReportError as exc:
+        print(f"rubass report: error: {exc}", file=sys.stderr)
+        return 1
+    except (OSError, ValueError) as exc:
+        print(f"rubass report: error: {args.bench}: {exc}", file=sys.stderr)
+        return 1
+    results = [run_file(path, args.actions) for path in args.tests]
+    for r in results:
+        for w in r.warnings:
+            print(w, file=sys.stderr)
+        if r.error:
+            print(r.error, file=sys.stderr)
+        elif r.spec is not None and os.path.realpath(r.spec.path) != os.path.realpath(spec.path):
+            print(f"rubass report: warning: {r.path} tests {r.spec.path}, not {args.spec}", file=sys.stderr)
+    bags = [replay_bag(spec, path) for path in args.bag]
+    for b in bags:
+        if b.error:
+            print(f"rubass report: error: {b.error}", file=sys.stderr)
+    ev = Evidence(spec, hazards, results, bags, reaction)
+    build_matrix(ev)
+    text = render(ev)
+    tmp = args.output + ".tmp"
+    try:
+        with open(tmp, "w", encoding="utf-8") as fh:
+            fh.write(text)
+        os.replace(tmp, args.output)
+    except OSError as exc:
+        print(f"rubass report: error: cannot write {args.output}: {exc.strerror or exc}", file=sys.stderr)
+        return 1
+    outcomes = ev.outcomes
+    failed = sum(not o.passed for o in outcomes)
+    gaps = sum(1 for row in ev.matrix if row.gaps)
+    print(f"report written to {args.output}: {len(outcomes) - failed} tests passed, {failed} failed, "
+          f"{gaps} gap{'s' if gaps != 1 else ''} in the matrix")
+    return 1 if failed or any(r.error for r in results) or any(b.error for b in bags) else 0

@@ -1,0 +1,204 @@
+"""What a report shows, gathered: the spec's traceability, test results, bag replays, measured reaction."""
+from __future__ import annotations
+
+
+from dataclasses import dataclass, field
+from typing import Any, Dict, List, Optional, Sequence, Set
+
+import yaml
+
+from ..engine import Event
+from ..lang import ast
+from ..lang.model import CheckedSpec
+from ..testing.coverage import Coverage, coverage
+from ..testing.results import FileResult
+from ..testing.runner import Outcome
+from .bench import Reaction
+
+
+class ReportError(Exception):
+    """An input of the report that cannot be used; the message says which and why."""
+
+
+@dataclass
+class Hazard:
+    id: str
+    title: str = ""
+    details: Dict[str, str] = field(default_factory=dict)  # severity, probability… from the risk table
+
+
+@dataclass
+class BagRun:
+    path: str
+    duration: float = 0.0
+    messages: int = 0
+    events: List[Event] = field(default_factory=list)
+    error: str = ""
+    warnings: List[str] = field(default_factory=list)
+
+
+@dataclass
+class Row:
+    """One line of the traceability matrix: a hazard and one rule (or none) for it."""
+
+    hazard: Hazard
+    rule: Optional[str]  # rule key; None: the hazard has no rule
+    behaviours: List[str]
+    tests: List[Outcome]
+    gaps: List[str]
+
+
+@dataclass
+class Evidence:
+    spec: CheckedSpec
+    hazards: List[Hazard]
+    results: List[FileResult]
+    bags: List[BagRun]
+    reaction: Optional[Reaction]
+    matrix: List[Row] = field(default_factory=list)
+    coverage: Optional[Coverage] = None
+
+    @property
+    def outcomes(self) -> List[Outcome]:
+        return [o for r in self.results for o in r.outcomes]
+
+
+def read_hazards(path: str) -> List[Hazard]:
+    """A risk-assessment table: `hazards: [{id: H1, title: …, severity: …}, …]`."""
+    try:
+        with open(path, encoding="utf-8") as fh:
+            doc = yaml.safe_load(fh)
+    except OSError as exc:
+        raise ReportError(f"{path}: cannot read: {exc.strerror or exc}") from None
+    except yaml.YAMLError as exc:
+        raise ReportError(f"{path}: not valid YAML: {exc}") from None
+    items = doc.get("hazards") if isinstance(doc, dict) else None
+    if not isinstance(items, list):
+        raise ReportError(f"{path}: expected 'hazards:' with a list of {{id: …, title: …}}")
+    out: List[Hazard] = []
+    for i, h in enumerate(items):
+        if not isinstance(h, dict) or not isinstance(h.get("id"), (str, int)):
+            raise ReportError(f"{path}: hazard {i + 1} needs an id")
+        details = {str(k): str(v) for k, v in h.items() if k not in ("id", "title")}
+        out.append(Hazard(str(h["id"]), str(h.get("title", "")), details))
+    return out
+
+
+def attrs(owner: Any) -> Dict[str, Sequence[str]]:
+    return getattr(owner, "attrs", None) or {}
+
+
+def behaviour_label(spec: CheckedSpec, index: int) -> str:
+    b = spec.behaviours[index - 1]
+    return b.name if getattr(b, "name", "") else f"behaviour {index}"
+
+
+def _rules_used(spec: CheckedSpec, expr: ast.Expr) -> Set[str]:
+    """Rules an expression uses, directly or through other rules."""
+    by_key = {r.key: r for r in spec.rules}
+    out: Set[str] = set()
+    stack = [e.key for e in ast.walk(expr) if isinstance(e, ast.RuleRef)]
+    while stack:
+        k = stack.pop()
+        if k in out or k not in by_key:
+            continue
+        out.add(k)
+        stack.extend(by_key[k].rule_deps)
+    return out
+
+
+def build_matrix(ev: Evidence) -> None:
+    """Hazard -> rule -> behaviour -> test, with the gaps marked."""
+    spec = ev.spec
+    known = {h.id for h in ev.hazards}
+    for owner in list(spec.rules) + list(spec.behaviours):
+        for hz in attrs(owner).get("hazard", ()):
+            if hz not in known:
+                ev.hazards.append(Hazard(hz, "(named in the spec, not in the risk table)"))
+                known.add(hz)
+    uses = {b.index: _rules_used(spec, b.cond) for b in spec.behaviours}
+    outcomes = ev.outcomes
+    for h in ev.hazards:
+        rules = [r for r in spec.rules if h.id in attrs(r).get("hazard", ())]
+        direct_b = [b for b in spec.behaviours if h.id in attrs(b).get("hazard", ())]
+        if not rules and not direct_b:
+            ev.matrix.append(Row(h, None, [], [o for o in outcomes if h.id in o.covers], ["no rule"]))
+            continue
+        for r in rules:
+            users = [b for b in spec.behaviours if r.key in uses[b.index]]
+            ids = set(attrs(r).get("id", ()))
+            for b in users:
+                ids |= set(attrs(b).get("id", ()))
+            tests = [o for o in outcomes if ids & set(o.covers) or r.key in o.rules_true]
+            ev.matrix.append(Row(h, r.key, [behaviour_label(spec, b.index) for b in users], tests, _gaps(users, tests)))
+        for b in direct_b:
+            if any(r.key in uses[b.index] for r in rules):
+                continue  # shown with its rule
+            ids = set(attrs(b).get("id", ()))
+            tests = [o for o in outcomes if ids & set(o.covers) or b.index in o.started]
+            ev.matrix.append(Row(h, None, [behaviour_label(spec, b.index)], tests, _gaps([b], tests)))
+    if outcomes:
+        ev.coverage = coverage(spec, outcomes)
+
+
+def _gaps(users: List[Any], tests: List[Outcome]) -> List[str]:
+    gaps = []
+    if not users:
+        gaps.append("no behaviour acts on it")
+    if not tests:
+        gaps.append("no test")
+    gaps += [f"test '{o.name}' fails" for o in tests if not o.passed]
+    return gaps
+
+
+def replay_bag(spec: CheckedSpec, path: str, rate: float = 50.0) -> BagRun:
+    """The spec over a recording, as `rubass replay` runs it."""
+    from ..replay.run import replay
+    from ..ros.bag import BagError, open_bag, read
+
+    run = BagRun(path)
+    try:
+        bag, info = open_bag(path)
+    except BagError as exc:
+        run.error = str(exc)
+        return run
+    with bag:
+        names = {(t if t.startswith("/") else "/" + t): t for t in spec.topics}
+        present = [t for t in names if t in info.types]
+        run.warnings = [f"topic {t} is not in the recording; its values stay unknown" for t in sorted(names)
+                        if t not in info.types]
+        node_topics = sorted(t for t, ty in info.types.items() if t.endswith("/node_samples") and ty == "std_msgs/String")
+        node_topics = node_topics if spec.nodes else []
+        decode = {t for t in present if spec.topics[names[t]].needs_data} | set(node_topics)
+        stream = ((t, names.get(topic, topic), msg) for t, topic, msg in read(bag, present + node_topics, decode))
+        try:
+            _, run.events = replay(spec, stream, info.start, info.end, rate, node_topics)
+        except BagError as exc:
+            run.error = str(exc)
+            return run
+    run.duration, run.messages = info.end - info.start, info.messages
+    return run
+
+
+def spec_text(spec: CheckedSpec, span: Any) -> str:
+    """The source text at a span (a rule's or a behaviour's own text)."""
+    src = spec.sources.get(span.file) if getattr(spec, "sources", None) is not None else None
+    if src is not None and span.end > span.start:
+        return src.text[span.start:span.end].strip()
+    try:
+        with open(span.file, encoding="utf-8") as fh:
+            return fh.read().splitlines()[span.line - 1].strip()
+    except (OSError, IndexError):
+        return ""
+
+
+def design_times(expr: ast.Expr) -> List[float]:
+    """The `for` / `within` durations of an expression (its own reaction time by design)."""
+    out = []
+    for e in ast.walk(expr):
+        dur = getattr(e, "duration", None)
+        if isinstance(dur, ast.Lit) and isinstance(dur.value, float):
+            out.append(dur.value)
+    return out
+
+

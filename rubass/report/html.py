@@ -1,0 +1,188 @@
+"""The report as one self-contained HTML page: inline CSS and SVG, no script, no external file."""
+from __future__ import annotations
+
+import datetime
+import os
+import platform
+from html import escape
+from typing import Any, Iterable, List, Sequence
+
+from .evidence import Evidence, attrs, behaviour_label, design_times, spec_text
+from .timeline import svg
+
+CSS = """
+body{font-family:system-ui,-apple-system,"Segoe UI",sans-serif;margin:2em auto;max-width:1100px;color:#222;
+  line-height:1.4;padding:0 1em}
+h1{font-size:1.6em;margin-bottom:.2em}h2{border-bottom:2px solid #ddd;padding-bottom:.2em;margin-top:1.8em}
+table{border-collapse:collapse;width:100%;margin:.6em 0;font-size:.92em}
+th,td{border:1px solid #ccc;padding:.3em .5em;text-align:left;vertical-align:top}
+th{background:#f3f3f3}code,pre{font-family:ui-monospace,Menlo,Consolas,monospace;font-size:.9em}
+pre{background:#f7f7f7;padding:.5em;overflow-x:auto;margin:.2em 0;white-space:pre-wrap}
+.pass{color:#1a7f37;font-weight:bold}.fail{color:#c62828;font-weight:bold}
+.gap{background:#fde7e7}.ok{background:#e8f5e9}.muted{color:#777}
+.summary{display:flex;gap:1em;flex-wrap:wrap}.card{border:1px solid #ccc;border-radius:6px;padding:.6em 1em;min-width:12em}
+.card b{font-size:1.4em;display:block}
+.w{font-family:ui-monospace,Menlo,Consolas,monospace;font-size:.88em}
+"""
+
+
+def _e(text: Any) -> str:
+    return escape(str(text))
+
+
+def _list(items: Iterable[str]) -> str:
+    items = list(items)
+    return ", ".join(_e(i) for i in items) if items else '<span class="muted">—</span>'
+
+
+def _attr(owner: Any, key: str) -> str:
+    return _list(attrs(owner).get(key, ()))
+
+
+def _table(head: Sequence[str], rows: List[str]) -> str:
+    return ("<table><thead><tr>" + "".join(f"<th>{_e(h)}</th>" for h in head) + "</tr></thead><tbody>"
+            + "".join(rows) + "</tbody></table>")
+
+
+def _seconds(values: List[float]) -> str:
+    return " + ".join(f"{v:g} s" for v in values) if values else "immediate"
+
+
+def render(ev: Evidence) -> str:
+    spec = ev.spec
+    outcomes = ev.outcomes
+    passed = sum(o.passed for o in outcomes)
+    failed = len(outcomes) - passed
+    gaps = sum(1 for row in ev.matrix if row.gaps)
+    errors = [r for r in ev.results if r.error]
+    now = datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%d %H:%M UTC")
+    out = [f"<!DOCTYPE html><html lang='en'><head><meta charset='utf-8'><title>Safety evidence: "
+           f"{_e(os.path.basename(spec.path))}</title><style>{CSS}</style></head><body>",
+           f"<h1>Safety evidence for <code>{_e(os.path.basename(spec.path))}</code></h1>",
+           f"<p class='muted'>{_e(spec.path)} · generated {now} by rubass report on {_e(platform.node())} "
+           f"({_e(platform.machine())}, Python {_e(platform.python_version())})</p>"]
+    reaction = (f"<b>≤ {ev.reaction.worst_ms:g} ms</b>worst case measured (p99 {ev.reaction.p99_ms:g} ms)"
+                if ev.reaction else "<b>n/a</b>no benchmark figures")
+    out.append("<div class='summary'>"
+               f"<div class='card'><b>{len(ev.hazards)}</b>hazards</div>"
+               f"<div class='card'><b>{len(spec.rules)} / {len(spec.behaviours)}</b>rules / behaviours</div>"
+               f"<div class='card'><b class='{'fail' if failed or errors else 'pass'}'>{passed} passed, {failed} failed"
+               f"</b>tests{f', {len(errors)} file(s) could not run' if errors else ''}</div>"
+               f"<div class='card'><b class='{'fail' if gaps else 'pass'}'>{gaps}</b>gaps in the matrix</div>"
+               f"<div class='card'>{reaction}</div></div>")
+    out += _matrix(ev), _rules(ev), _behaviours(ev), _tests(ev), _bags(ev)
+    out.append("</body></html>")
+    return "\n".join(out)
+
+
+def _matrix(ev: Evidence) -> str:
+    rows = []
+    for row in ev.matrix:
+        h = row.hazard
+        details = "; ".join(f"{k}: {v}" for k, v in h.details.items())
+        rule = ev.spec.rule(row.rule) if row.rule else None
+        rule_cell = (f"<code>{_e(row.rule)}</code><br>{_attr(rule, 'id')} {_e(' '.join(attrs(rule).get('title', ())))}"
+                     if rule is not None else '<span class="muted">—</span>')
+        tests = "<br>".join(f"<span class='{'pass' if o.passed else 'fail'}'>{'✔' if o.passed else '✘'}</span> "
+                            f"{_e(o.name)}" for o in row.tests) or '<span class="muted">—</span>'
+        status = ("<td class='gap'>" + "<br>".join(_e(g) for g in row.gaps) + "</td>") if row.gaps \
+            else "<td class='ok'>covered</td>"
+        rows.append(f"<tr><td><b>{_e(h.id)}</b> {_e(h.title)}<br><span class='muted'>{_e(details)}</span></td>"
+                    f"<td>{rule_cell}</td><td>{_list(row.behaviours)}</td><td>{tests}</td>{status}</tr>")
+    note = ("<p>Each hazard of the risk assessment, the rules that detect it (<code>@hazard</code>), the behaviours "
+            "that act on those rules, and the tests that cover them (by <code>covers</code>, or by making the rule "
+            "true). Gaps are marked red: a hazard with no rule, a rule with no test, a failing test.</p>")
+    return "<h2 id='matrix'>Hazard → rule → behaviour → test</h2>" + note + \
+        _table(["hazard", "rule", "behaviours", "tests", "status"], rows)
+
+
+def _reaction_note(ev: Evidence) -> str:
+    if ev.reaction is None:
+        return "<p>No benchmark figures were found, so the monitor's own reaction is not stated.</p>"
+    r = ev.reaction
+    return (f"<p>Every rule's reaction by design is its own times (<code>for</code>, <code>within</code>). The monitor "
+            f"adds its own reaction, measured on this machine from the violating message to the stop received by "
+            f"the base: p50 {r.p50_ms:g} ms, p99 {r.p99_ms:g} ms, <b>worst {r.worst_ms:g} ms</b> over {r.cases} "
+            f"cases (source: {_e(r.source)}).</p>")
+
+
+def _rules(ev: Evidence) -> str:
+    rows = []
+    worst = ev.reaction.worst_ms if ev.reaction else None
+    for r in ev.spec.rules:
+        times = design_times(r.expr)
+        total = sum(times)
+        bound = f"{_seconds(times)}" + (f" + ≤ {worst:g} ms = ≤ {total + worst / 1000:.4g} s" if worst is not None else "")
+        rows.append(f"<tr><td><code>{_e(r.key)}</code></td><td>{_attr(r, 'id')}</td><td>{_attr(r, 'hazard')}</td>"
+                    f"<td>{_attr(r, 'title')}</td><td>{_attr(r, 'ref')}</td><td>{bound}</td>"
+                    f"<td><pre>{_e(spec_text(ev.spec, r.span))}</pre></td></tr>")
+    return ("<h2 id='rules'>Rules</h2>" + _reaction_note(ev)
+            + _table(["rule", "id", "hazard", "title", "ref", "reaction (design + measured)", "text"], rows))
+
+
+def _behaviours(ev: Evidence) -> str:
+    rows = []
+    for b in ev.spec.behaviours:
+        rows.append(f"<tr><td>{b.index}</td><td><b>{_e(behaviour_label(ev.spec, b.index))}</b></td>"
+                    f"<td>{_attr(b, 'id')}</td><td>{_attr(b, 'hazard')}</td><td>{_attr(b, 'title')}</td>"
+                    f"<td>{_list(a.name for a in b.actions)}</td><td>{_seconds(design_times(b.cond))}</td>"
+                    f"<td><pre>{_e(spec_text(ev.spec, b.span))}</pre></td></tr>")
+    return "<h2 id='behaviours'>Behaviours</h2>" + _table(
+        ["#", "name", "id", "hazard", "title", "actions", "own time", "text"], rows)
+
+
+def _tests(ev: Evidence) -> str:
+    if not ev.results:
+        return "<h2 id='tests'>Tests</h2><p class='fail'>No test file was given (--tests).</p>"
+    parts = ["<h2 id='tests'>Tests</h2>"]
+    for r in ev.results:
+        parts.append(f"<h3><code>{_e(os.path.relpath(r.path))}</code></h3>")
+        if r.error:
+            parts.append(f"<pre class='fail'>{_e(r.error)}</pre>")
+            continue
+        rows = []
+        for o in r.outcomes:
+            verdict = "<span class='pass'>PASS</span>" if o.passed else "<span class='fail'>FAIL</span>"
+            problems = f"<pre>{_e(chr(10).join(o.problems))}</pre>" if o.problems else ""
+            rows.append(f"<tr><td>{verdict}</td><td>{_e(o.name)}{problems}</td><td>{_list(o.covers)}</td>"
+                        f"<td>{o.duration:g} s</td></tr>")
+        parts.append(_table(["result", "test", "covers", "simulated"], rows))
+    cov = ev.coverage
+    if cov is not None:
+        parts.append("<h3>Coverage over all tests</h3>" + _table(["", ""], [
+            f"<tr><th>rules never true</th><td>{_list(cov.rules_never_true)}</td></tr>",
+            f"<tr><th>behaviours never started</th><td>{_list(cov.behaviours_never_started)}</td></tr>",
+            f"<tr><th>ids no test covers</th><td>{_list(cov.ids_untested)}</td></tr>",
+            f"<tr><th>hazards no test covers</th><td>{_list(cov.hazards_untested)}</td></tr>"]))
+    return "".join(parts)
+
+
+def _bags(ev: Evidence) -> str:
+    if not ev.bags:
+        return "<h2 id='recordings'>Recordings</h2><p class='muted'>No recording was given (--bag).</p>"
+    labels = {b.index: behaviour_label(ev.spec, b.index) for b in ev.spec.behaviours}
+    parts = ["<h2 id='recordings'>Recordings</h2>"]
+    for run in ev.bags:
+        parts.append(f"<h3><code>{_e(os.path.relpath(run.path))}</code></h3>")
+        if run.error:
+            parts.append(f"<pre class='fail'>{_e(run.error)}</pre>")
+            continue
+        parts.append(f"<p>{run.duration:.3f} s, {run.messages} messages. Rules: red true, green false, grey "
+                     f"unknown; behaviours: orange while active, ▼ at each start.</p>")
+        parts += [f"<p class='muted'>{_e(w)}</p>" for w in run.warnings]
+        parts.append(svg(ev.spec, run.events, run.duration, labels))
+        rows = []
+        for e in run.events:
+            if e.kind not in ("start", "release"):
+                continue
+            w = getattr(e, "witness", None)
+            why = ""
+            if w is not None:
+                why = ("true: " + ", ".join(f"<code>{_e(k)}</code>" for k in w.rules) + "<br>" if w.rules else "") + \
+                    "<br>".join(f"<span class='w'>{_e(r.text())}</span>" for r in w.readings)
+            rows.append(f"<tr><td>{e.time:.3f} s</td><td>{_e(e.kind)}</td><td>{_e(labels.get(e.behaviour, ''))}</td>"
+                        f"<td>{_attr(ev.spec.behaviours[e.behaviour - 1], 'id')}</td><td>{_list(e.actions)}</td>"
+                        f"<td>{why}</td></tr>")
+        parts.append(_table(["time", "event", "behaviour", "id", "actions", "why (witnesses)"], rows) if rows
+                     else "<p>No behaviour started.</p>")
+    return "".join(parts)
