@@ -17,5 +17,13 @@ export PYTHONDONTWRITEBYTECODE=1
 PY=/usr/bin/python3
 echo "== rubass check config/kobuki.rbs config/frobit.rbs"
 $PY -m rubass check config/kobuki.rbs config/frobit.rbs
+echo "== rubass test config/tests/*.test.yaml (the rule tests of both robots, with coverage)"
+$PY -m rubass test config/tests/kobuki.test.yaml config/tests/frobit.test.yaml --coverage
+mkdir -p out/report
+for robot in kobuki frobit; do
+  $PY -m rubass report "config/$robot.rbs" --tests "config/tests/$robot.test.yaml" \
+    --hazards "config/${robot}_hazards.yaml" -o "out/report/$robot.html"
+done
+echo "evidence for a certifier (hazards, rules, tests, reaction; docs/report.md): $PWD/out/report/kobuki.html and $PWD/out/report/frobit.html"
 echo "== rubass experiments --reps ${REPS:-2} (quick mode)"
 exec $PY -m rubass experiments --reps "${REPS:-2}" --out out/experiments

@@ -202,3 +202,30 @@ def design_times(expr: ast.Expr) -> List[float]:
     return out
 
 
+
+
+def rule_time(spec: CheckedSpec, key: str, _seen: Optional[Set[str]] = None) -> float:
+    """The longest chain of `for`/`within` times through a rule and the rules it uses."""
+    seen = _seen or set()
+    if key in seen:
+        return 0.0
+    seen.add(key)
+    rule = spec.rule(key)
+    deps = [rule_time(spec, d, set(seen)) for d in rule.rule_deps]
+    return sum(design_times(rule.expr)) + max(deps, default=0.0)
+
+
+def behaviour_time(spec: CheckedSpec, b: Any) -> float:
+    """The same for a behaviour: its own times plus its slowest rule's."""
+    used = {e.key for e in ast.walk(b.cond) if isinstance(e, ast.RuleRef)}
+    return sum(design_times(b.cond)) + max((rule_time(spec, k) for k in used), default=0.0)
+
+
+def hazards_via_rules(spec: CheckedSpec, b: Any) -> List[str]:
+    """Hazards of the rules a behaviour uses (directly or through other rules)."""
+    out: List[str] = []
+    for key in sorted(_rules_used(spec, b.cond)):
+        for h in attrs(spec.rule(key)).get("hazard", ()):
+            if h not in out:
+                out.append(h)
+    return out

@@ -7,7 +7,8 @@ import platform
 from html import escape
 from typing import Any, Iterable, List, Sequence
 
-from .evidence import Evidence, attrs, behaviour_label, design_times, spec_text
+from .evidence import (Evidence, attrs, behaviour_label, behaviour_time, design_times, hazards_via_rules, rule_time,
+                       spec_text)
 from .timeline import svg
 
 CSS = """
@@ -24,6 +25,11 @@ pre{background:#f7f7f7;padding:.5em;overflow-x:auto;margin:.2em 0;white-space:pr
 .card b{font-size:1.4em;display:block}
 .w{font-family:ui-monospace,Menlo,Consolas,monospace;font-size:.88em}
 """
+
+
+def _shown(path: str) -> str:
+    rel = os.path.relpath(path)
+    return path if rel.startswith("..") else rel
 
 
 def _e(text: Any) -> str:
@@ -111,7 +117,9 @@ def _rules(ev: Evidence) -> str:
     worst = ev.reaction.worst_ms if ev.reaction else None
     for r in ev.spec.rules:
         times = design_times(r.expr)
-        total = sum(times)
+        total = rule_time(ev.spec, r.key)
+        if total != sum(times):
+            times = [total]  # through the rules it uses
         bound = f"{_seconds(times)}" + (f" + ≤ {worst:g} ms = ≤ {total + worst / 1000:.4g} s" if worst is not None else "")
         rows.append(f"<tr><td><code>{_e(r.key)}</code></td><td>{_attr(r, 'id')}</td><td>{_attr(r, 'hazard')}</td>"
                     f"<td>{_attr(r, 'title')}</td><td>{_attr(r, 'ref')}</td><td>{bound}</td>"
@@ -122,13 +130,22 @@ def _rules(ev: Evidence) -> str:
 
 def _behaviours(ev: Evidence) -> str:
     rows = []
+    worst = ev.reaction.worst_ms if ev.reaction else None
     for b in ev.spec.behaviours:
+        hazards = list(attrs(b).get("hazard", ()))
+        via = [h for h in hazards_via_rules(ev.spec, b) if h not in hazards]
+        hz = _list(hazards) if hazards else ""
+        hz += (" " if hz else "") + (f"<span class='muted'>via rules: {_list(via)}</span>" if via else "")
+        total = behaviour_time(ev.spec, b)
+        bound = f"{total:g} s" + (f" + ≤ {worst:g} ms" if worst is not None else "")
         rows.append(f"<tr><td>{b.index}</td><td><b>{_e(behaviour_label(ev.spec, b.index))}</b></td>"
-                    f"<td>{_attr(b, 'id')}</td><td>{_attr(b, 'hazard')}</td><td>{_attr(b, 'title')}</td>"
-                    f"<td>{_list(a.name for a in b.actions)}</td><td>{_seconds(design_times(b.cond))}</td>"
+                    f"<td>{_attr(b, 'id')}</td><td>{hz or _list([])}</td><td>{_attr(b, 'title')}</td>"
+                    f"<td>{_list(a.name for a in b.actions)}</td><td>{bound}</td>"
                     f"<td><pre>{_e(spec_text(ev.spec, b.span))}</pre></td></tr>")
-    return "<h2 id='behaviours'>Behaviours</h2>" + _table(
-        ["#", "name", "id", "hazard", "title", "actions", "own time", "text"], rows)
+    return ("<h2 id='behaviours'>Behaviours</h2><p>A behaviour's time is the longest chain of <code>for</code> and "
+            "<code>within</code> times from its inputs through its rules to its condition, plus the monitor's measured "
+            "worst case.</p>" + _table(["#", "name", "id", "hazard", "title", "actions", "reaction (design + measured)",
+                                        "text"], rows))
 
 
 def _tests(ev: Evidence) -> str:
@@ -136,7 +153,7 @@ def _tests(ev: Evidence) -> str:
         return "<h2 id='tests'>Tests</h2><p class='fail'>No test file was given (--tests).</p>"
     parts = ["<h2 id='tests'>Tests</h2>"]
     for r in ev.results:
-        parts.append(f"<h3><code>{_e(os.path.relpath(r.path))}</code></h3>")
+        parts.append(f"<h3><code>{_e(_shown(r.path))}</code></h3>")
         if r.error:
             parts.append(f"<pre class='fail'>{_e(r.error)}</pre>")
             continue
@@ -149,11 +166,15 @@ def _tests(ev: Evidence) -> str:
         parts.append(_table(["result", "test", "covers", "simulated"], rows))
     cov = ev.coverage
     if cov is not None:
-        parts.append("<h3>Coverage over all tests</h3>" + _table(["", ""], [
-            f"<tr><th>rules never true</th><td>{_list(cov.rules_never_true)}</td></tr>",
-            f"<tr><th>behaviours never started</th><td>{_list(cov.behaviours_never_started)}</td></tr>",
-            f"<tr><th>ids no test covers</th><td>{_list(cov.ids_untested)}</td></tr>",
-            f"<tr><th>hazards no test covers</th><td>{_list(cov.hazards_untested)}</td></tr>"]))
+        def line(title: str, items: List[str]) -> str:
+            cell = f"<td class='gap'>{_list(items)}</td>" if items else "<td class='ok'>none</td>"
+            return f"<tr><th>{_e(title)}</th>{cell}</tr>"
+
+        parts.append("<h3>Coverage over all tests</h3><table><tbody>"
+                     + line("rules never true", cov.rules_never_true)
+                     + line("behaviours never started", cov.behaviours_never_started)
+                     + line("ids no test covers", cov.ids_untested)
+                     + line("hazards no test covers", cov.hazards_untested) + "</tbody></table>")
     return "".join(parts)
 
 
@@ -163,7 +184,7 @@ def _bags(ev: Evidence) -> str:
     labels = {b.index: behaviour_label(ev.spec, b.index) for b in ev.spec.behaviours}
     parts = ["<h2 id='recordings'>Recordings</h2>"]
     for run in ev.bags:
-        parts.append(f"<h3><code>{_e(os.path.relpath(run.path))}</code></h3>")
+        parts.append(f"<h3><code>{_e(_shown(run.path))}</code></h3>")
         if run.error:
             parts.append(f"<pre class='fail'>{_e(run.error)}</pre>")
             continue
