@@ -1,12 +1,14 @@
 """The rule engine: fed events with their times, it answers with what changed.
 
-Time is always an argument; the engine reads no clock. A message re-evaluates only the rules
-that depend on its topic (and the rules and behaviours that use those), in dependency order.
-`for` timers report their deadlines; `next_deadline()` tells the caller when to wake.
+Time is always an argument; the engine reads no clock. Rules and behaviours form one
+evaluation graph in the dependency order the checker built (§14): a message re-evaluates only
+what depends on its topic, directly or through rules, behaviours and `active()`, in that order,
+so a behaviour sees within the same instant the action state that others have just produced.
+Stateful operators (for, within, latch, crossings of time) announce their deadlines;
+`next_deadline()` tells the caller when to wake.
 """
 from __future__ import annotations
 
-import functools
 import heapq
 import itertools
 from dataclasses import dataclass
@@ -18,7 +20,6 @@ from .evaluate import Compiled, Compiler
 from .explain import Explainer, Witness
 from .fields import FieldError, extract
 from .store import Store
-from .temporal import ForTimer
 from .values import UNKNOWN
 
 
@@ -37,20 +38,23 @@ class Event:
     witness: Optional[Witness] = None  # at a start: the true rules and the values they read (explain.py)
 
 
-@dataclass
-class _Plan:
-    """What one kind of input makes the engine re-evaluate, in dependency order."""
+class _Node:
+    """One rule or behaviour of the evaluation graph."""
 
-    rules: Tuple[int, ...]
-    behaviours: Tuple[int, ...]
+    __slots__ = ("key", "compiled", "behaviour", "active", "value", "actions", "users", "pushed")
 
-
-class _Behaviour:
-    def __init__(self, checked: CheckedBehaviour, compiled: Compiled) -> None:
-        self.checked, self.compiled = checked, compiled
+    def __init__(self, key: str, compiled: Compiled, behaviour: Optional[CheckedBehaviour]) -> None:
+        self.key, self.compiled, self.behaviour = key, compiled, behaviour
         self.active = False
         self.value: Any = UNKNOWN
-        self.actions = tuple(a.name for a in checked.actions)
+        self.actions: Tuple[str, ...] = tuple(a.name for a in behaviour.actions) if behaviour else ()
+        self.users: Set[int] = set()
+        self.pushed: Dict[int, float] = {}  # id(op) -> the deadline already in the heap
+
+    @property
+    def checked(self) -> Optional[CheckedBehaviour]:
+        """The checked behaviour (None for a rule), as consumers of `orphans` read it."""
+        return self.behaviour
 
 
 class Engine:
@@ -59,75 +63,88 @@ class Engine:
     def __init__(self, spec: CheckedSpec, now: float) -> None:
         self.spec = spec
         self.store = Store(now)
-        self.orphans: List[_Behaviour] = []  # active behaviours of a replaced spec that this one lacks
+        self.orphans: List[Any] = []  # active behaviours of a replaced spec that this one lacks
         self.field_errors: Dict[Tuple[str, str], str] = {}
         self._explainer: Optional[Explainer] = None
-        compiler = Compiler(self.store)
-        self._keys = [r.key for r in spec.rules]
-        self._index = {k: i for i, k in enumerate(self._keys)}
-        self._rules = [compiler.compile(r.expr) for r in spec.rules]
-        self._behaviours = [_Behaviour(b, compiler.compile(b.cond)) for b in spec.behaviours]
-        self._paths = {t: tuple(sorted(u.paths, key=str)) for t, u in spec.topics.items()}
-        # (due, seq, kind 0 rule / 1 behaviour, index, the ForTimer or None, its start)
-        self._heap: List[Tuple[float, int, int, int, Optional[ForTimer], float]] = []
+        # action -> [is active]; the holders: behaviour keys ('b:N') or outside holders (restored latches)
+        self._active: Dict[str, List[bool]] = {a: [False] for a in spec.actions}
+        self._holders: Dict[str, Set[str]] = {}
+        self._compiler = Compiler(self.store, self._active)
+        order = spec.evaluation or [r.key for r in spec.rules] + [f"b:{b.index}" for b in spec.behaviours]
+        rules = {r.key: r for r in spec.rules}
+        self._nodes: List[_Node] = []
+        for key in order:
+            if key.startswith("b:"):
+                b = spec.behaviours[int(key[2:]) - 1]
+                self._nodes.append(_Node(key, self._compiler.compile(b.cond), b))
+            else:
+                self._nodes.append(_Node(key, self._compiler.compile(rules[key].expr), None))
+        self._at = {n.key: i for i, n in enumerate(self._nodes)}
+        self._behaviour_at = {int(n.key[2:]): i for i, n in enumerate(self._nodes) if n.behaviour}
+        self._heap: List[Tuple[float, int, int, Any]] = []  # (due, seq, node index, operator)
         self._seq = itertools.count()
-        self._timed_pushed: Dict[Tuple[int, int], Set[float]] = {}
-        for kind, compiled_list in ((0, self._rules), (1, [b.compiled for b in self._behaviours])):
-            for idx, compiled in enumerate(compiled_list):
-                for timer in compiled.timers:
-                    timer.notify = functools.partial(self._push_timer, kind, idx)
+        self._plan_inputs(spec, now)
+
+    # -- planning ------------------------------------------------------------------------
+    def _plan_inputs(self, spec: CheckedSpec, now: float) -> None:
         windows: Dict[str, float] = {}
-        direct: List[Tuple[Set[str], Set[str], bool]] = []
-        for expr in [r.expr for r in spec.rules] + [b.cond for b in spec.behaviours]:
-            topics, nodes, timed = set(), set(), False
+        topics_of: List[Set[str]] = []
+        nodes_of: List[Set[str]] = []
+        timed: List[int] = []
+        self._rate_paths: Dict[str, List[Tuple[ast.PathElem, ...]]] = {}
+        self._stamped: Set[str] = set()
+        self._laser: Set[str] = set()
+        readers: Dict[str, List[int]] = {}  # action -> nodes that read active(action)
+        for i, node in enumerate(self._nodes):
+            expr = node.behaviour.cond if node.behaviour else spec.rule(node.key).expr
+            topics, nodes = set(), set()
             for e in ast.walk(expr):
                 if isinstance(e, ast.TopicRef):
                     topics.add(e.topic)
-                elif isinstance(e, ast.NodeRef):
+                elif isinstance(e, (ast.Age, ast.Frequency, ast.StampAge)):
+                    topics.add(e.topic)
+                    if isinstance(e, ast.Frequency):
+                        windows[e.topic] = max(windows.get(e.topic, 0.0), e.window)
+                    if isinstance(e, ast.StampAge):
+                        self._stamped.add(e.topic)
+                elif isinstance(e, ast.NodeStat):
                     nodes.add(e.node)
-                elif isinstance(e, ast.Call) and e.func in ("age", "frequency"):
-                    timed = True
-                    if e.func == "frequency":
-                        w = e.args[1].value if len(e.args) > 1 else 1.0  # type: ignore[union-attr]
-                        t = e.args[0].topic  # type: ignore[union-attr]
-                        windows[t] = max(windows.get(t, 0.0), float(w))  # type: ignore[arg-type]
-            direct.append((topics, nodes, timed))
+                elif isinstance(e, ast.Rate):
+                    self._rate_paths.setdefault(e.ref.topic, []).append(e.ref.path)
+                elif isinstance(e, ast.ArrayFn) and e.ref.path[:1] == ("ranges",):
+                    self._laser.add(e.ref.topic)
+                elif isinstance(e, ast.Active):
+                    readers.setdefault(e.action, []).append(i)
+                elif isinstance(e, ast.RuleRef):
+                    self._nodes[self._at[e.key]].users.add(i)
+            if any(type(op).__name__ == "Crossings" for op in node.compiled.ops):
+                timed.append(i)
+            topics_of.append(topics)
+            nodes_of.append(nodes)
+        for node in self._nodes:
+            for action in node.actions:
+                node.users.update(readers.get(action, ()))
+        self._readers = readers
         for topic in spec.topics:
             self.store.watch(topic, now, windows.get(topic, 0.0))
-        self._users = self._rule_users(spec)
-        n = len(self._rules)
-        self._topic_plans = {t: self._plan([i for i, d in enumerate(direct) if t in d[0]]) for t in spec.topics}
-        self._node_plans = {nd: self._plan([i for i, d in enumerate(direct) if nd in d[1]]) for nd in spec.nodes}
-        self._tick_plan = self._plan([i for i, d in enumerate(direct) if d[2]])
-        self._rule_plans = [self._plan([i]) for i in range(n)]
-        self._all = self._plan(list(range(n + len(self._behaviours))))
+        self._paths = {t: tuple(sorted((p for p in u.paths if p not in self._rate_paths.get(t, ()) and p != STAMP),
+                                       key=str))
+                       for t, u in spec.topics.items()}
+        self._topic_plans = {t: self._plan([i for i, s in enumerate(topics_of) if t in s]) for t in spec.topics}
+        self._node_plans = {n: self._plan([i for i, s in enumerate(nodes_of) if n in s]) for n in spec.nodes}
+        self._tick_plan = self._plan(timed)
+        self._all = tuple(range(len(self._nodes)))
 
-    # -- planning ------------------------------------------------------------------------
-    def _rule_users(self, spec: CheckedSpec) -> List[Set[int]]:
-        users: List[Set[int]] = [set() for _ in spec.rules]
-        n = len(spec.rules)
-        for i, r in enumerate(spec.rules):
-            for dep in r.rule_deps:
-                users[self._index[dep]].add(i)
-        for j, b in enumerate(spec.behaviours):
-            for e in ast.walk(b.cond):
-                if isinstance(e, ast.RuleRef):
-                    users[self._index[e.key]].add(n + j)
-        return users
-
-    def _plan(self, seeds: List[int]) -> _Plan:
-        """Seeds (rule indices, then n + behaviour index) and everything that uses them."""
-        n = len(self._rules)
+    def _plan(self, seeds: Iterable[int]) -> Tuple[int, ...]:
+        """The seeds and everything that uses them, in evaluation order."""
         seen: Set[int] = set()
         stack = list(seeds)
         while stack:
             i = stack.pop()
-            if i in seen:
-                continue
-            seen.add(i)
-            if i < n:
-                stack.extend(self._users[i])
-        return _Plan(tuple(sorted(i for i in seen if i < n)), tuple(sorted(i - n for i in seen if i >= n)))
+            if i not in seen:
+                seen.add(i)
+                stack.extend(self._nodes[i].users)
+        return tuple(sorted(seen))
 
     # -- inputs --------------------------------------------------------------------------
     def on_message(self, topic: str, now: float, msg: Any = None) -> List[Event]:
@@ -145,54 +162,63 @@ class Engine:
             topic, msg = items[0]
             self._store_message(topic, now, msg)
             plan = self._topic_plans.get(topic)
-            if plan is not None:
+            if plan:
                 self._run(plan, events)
             events += self.advance(now)
             return events
-        rules: Set[int] = set()
-        behaviours: Set[int] = set()
+        seeds: Set[int] = set()
         for topic, msg in items:
             self._store_message(topic, now, msg)
-            plan = self._topic_plans.get(topic)
-            if plan is not None:
-                rules.update(plan.rules)
-                behaviours.update(plan.behaviours)
-        if rules or behaviours:
-            self._run(_Plan(tuple(sorted(rules)), tuple(sorted(behaviours))), events)
+            seeds.update(self._topic_plans.get(topic, ()))
+        if seeds:
+            self._run(tuple(sorted(seeds)), events)
         events += self.advance(now)
         return events
 
     def _store_message(self, topic: str, now: float, msg: Any) -> None:
-        self.store.arrive(topic, now)
+        store = self.store
+        store.arrive(topic, now)
         for path in self._paths.get(topic, ()):
-            if msg is UNKNOWN:  # the shell could not read it: its fields are missing data
-                self.store.fields[(topic, path)] = UNKNOWN
-                continue
+            store.fields[(topic, path)] = self._read(topic, path, msg)
+        for path in self._rate_paths.get(topic, ()):
+            store.arrive_rate(topic, path, now, self._read(topic, path, msg))
+        if topic in self._stamped:
             try:
-                value = extract(msg, path)
-                self.field_errors.pop((topic, str(path)), None)
-            except FieldError as exc:
-                value = UNKNOWN
-                self.field_errors[(topic, str(path))] = str(exc)
-            self.store.fields[(topic, path)] = value
+                stamp = UNKNOWN if msg is UNKNOWN else _stamp(extract(msg, STAMP, raw=True))
+            except FieldError:
+                stamp = UNKNOWN  # a type with no header.stamp: stamp_age is unknown (§11)
+            store.stamps[topic] = stamp
+        if topic in self._laser:
+            store.laser_limits[topic] = _laser_limits(msg)
+
+    def _read(self, topic: str, path: Tuple[ast.PathElem, ...], msg: Any) -> Any:
+        if msg is UNKNOWN:  # the shell could not read it: its fields are missing data
+            return UNKNOWN
+        try:
+            value = extract(msg, path)
+            self.field_errors.pop((topic, str(path)), None)
+            return value
+        except FieldError as exc:
+            self.field_errors[(topic, str(path))] = str(exc)
+            return UNKNOWN
 
     def on_node_sample(self, node: str, now: float, alive: Any, cpu: Any = UNKNOWN, memory: Any = UNKNOWN) -> List[Event]:
         """A sample of a node: alive True/False/UNKNOWN, cpu share of a core, memory bytes."""
         events = self.advance(now, inclusive=False)
         self.store.nodes[node] = {"alive": alive, "cpu": cpu, "memory": memory}
         plan = self._node_plans.get(node)
-        if plan is not None:
+        if plan:
             self._run(plan, events)
         events += self.advance(now)
         return events
 
     def on_tick(self, now: float) -> List[Event]:
-        """A scheduler tick: time-dependent rules (age, frequency), then `hold` of every active behaviour."""
+        """A scheduler tick: time-dependent expressions, then `hold` of every active behaviour."""
         events = self.advance(now)
         self._run(self._tick_plan, events)
-        for j, b in enumerate(self._behaviours):
-            if b.active:
-                events.append(Event(now, "hold", j + 1, actions=b.actions, line=b.checked.span.line))
+        for node in self._nodes:
+            if node.active:
+                events.append(self._event(node, "hold"))
         return events
 
     def evaluate_all(self, now: float) -> List[Event]:
@@ -212,41 +238,70 @@ class Engine:
             due = self.next_deadline()
             if due is None or not (due <= now if inclusive else due < now):
                 break
-            _, _, kind, idx, _, _ = heapq.heappop(self._heap)
+            _, _, idx, _ = heapq.heappop(self._heap)
             self.store.now = max(self.store.now, due)
-            if kind == 0:
-                self._run(self._rule_plans[idx], events)
-            else:
-                self._run(_Plan((), (idx,)), events)
+            self._run(self._plan((idx,)), events)
         self.store.now = max(self.store.now, now)
         return events
 
     def next_deadline(self) -> Optional[float]:
-        """The next instant a value changes by itself: a `for`, an age crossing, a frequency window."""
+        """The next instant a value changes by itself: a `for`, `within`, a crossing of time."""
         heap = self._heap
         while heap:
-            due, _, kind, idx, timer, since = heap[0]
-            if timer is not None:
-                if timer.since == since:
-                    return due
-            else:
-                compiled = self._rules[idx] if kind == 0 else self._behaviours[idx].compiled
-                if due in compiled.time_deadlines(self.store, strict=False):
-                    return due
+            due, _, idx, op = heap[0]
+            if op.deadline() == due:
+                return due
             heapq.heappop(heap)  # its cause changed since: nothing happens then
+            self._nodes[idx].pushed.pop(id(op), None)
         return None
 
-    def _push_timer(self, kind: int, idx: int, due: float, timer: ForTimer, since: float) -> None:
-        heapq.heappush(self._heap, (due, next(self._seq), kind, idx, timer, since))
-
+    # -- actions -------------------------------------------------------------------------
     def reset(self, now: float) -> List[Event]:
-        """Release latched behaviours whose condition is no longer true."""
+        """Release latched behaviours whose condition is no longer true, and outside holders."""
         events = self.advance(now)
-        for j, b in enumerate(self._behaviours):
-            if b.active and b.value is not True:
-                b.active = False
-                events.append(Event(now, "release", j + 1, actions=b.actions, line=b.checked.span.line))
+        released: List[int] = []
+        for i, node in enumerate(self._nodes):
+            if node.active and node.value is not True:
+                node.active = False
+                released.append(i)
+                events.append(self._event(node, "release"))
+        for action in list(self._holders):
+            self._holders[action] = {h for h in self._holders[action] if h.startswith("b:")}
+        self._sync_actions()
+        seeds = [u for i in released for u in self._nodes[i].users]
+        seeds += [r for a in self._readers for r in self._readers[a]]
+        if seeds:
+            self._run(self._plan(seeds), events)
         return events
+
+    def hold_actions(self, actions: Iterable[str], holder: str, now: float) -> List[Event]:
+        """Make actions active on behalf of an outside holder (a latch restored after a restart),
+        until reset; nodes reading active() of them are evaluated at once."""
+        events = self.advance(now)
+        for a in actions:
+            self._holders.setdefault(a, set()).add(holder)
+        self._sync_actions()
+        seeds = [r for a in actions for r in self._readers.get(a, ())]
+        if seeds:
+            self._run(self._plan(seeds), events)
+        return events
+
+    def active_actions(self) -> Dict[str, Tuple[str, ...]]:
+        """Each active action and who holds it: behaviour names ('behaviour N' when unnamed) or outside holders."""
+        out: Dict[str, Tuple[str, ...]] = {}
+        for action, holders in self._holders.items():
+            if holders:
+                out[action] = tuple(sorted(self._holder_label(h) for h in holders))
+        return out
+
+    def _holder_label(self, holder: str) -> str:
+        if holder.startswith("b:"):
+            return self.spec.behaviours[int(holder[2:]) - 1].label
+        return holder
+
+    def _sync_actions(self) -> None:
+        for action, flag in self._active.items():
+            flag[0] = bool(self._holders.get(action))
 
     # -- live reload ---------------------------------------------------------------------
     def adopt(self, old: "Engine", now: float) -> List[Event]:
@@ -254,44 +309,56 @@ class Engine:
 
         Data (fields, arrivals, node samples) carries over for topics and nodes both specs
         use; a rule whose text and whose used rules' texts are unchanged keeps its value and
-        its `for` timers; a behaviour with an unchanged condition and actions keeps its state
-        (an active one does not start again). Topics new to this spec are watched from now.
+        its operators' state; a behaviour keeps its state when its name is unchanged (or, when
+        unnamed, its condition and actions), so an active one does not start again; outside
+        holders of actions (restored latches) stay. Topics new to this spec are watched from now.
         Returns the events of the first evaluation. Call it on the engine's thread.
         """
         old.advance(now)
         src, dst = old.store, self.store
         for topic in self.spec.topics:
             if topic in old.spec.topics:
-                dst.watch_start[topic] = src.watch_start[topic]
-                if topic in src.last_arrival:
-                    dst.last_arrival[topic] = src.last_arrival[topic]
-                dst.carry_arrivals(src, topic)
+                dst.carry_topic(src, topic)
             else:
                 dst.watch_start[topic] = now
         dst.fields.update({k: v for k, v in src.fields.items() if k[0] in self.spec.topics})
         dst.nodes.update({n: v for n, v in src.nodes.items() if n in self.spec.nodes})
         dst.now = max(dst.now, now)
-        old_rules = {r.key: (r.signature, old._rules[i]) for i, r in enumerate(old.spec.rules)}
-        for i, r in enumerate(self.spec.rules):
-            prev = old_rules.get(r.key)
-            if prev is not None and prev[0] == r.signature:
-                self._take_timers(prev[1], self._rules[i])
-                if r.key in src.rules:
-                    dst.rules[r.key] = src.rules[r.key]
-        old_behaviours = {b.checked.signature: b for b in old._behaviours}
-        for b in self._behaviours:
-            prev_b = old_behaviours.pop(b.checked.signature, None)
-            if prev_b is not None:
-                self._take_timers(prev_b.compiled, b.compiled)
-                b.active, b.value = prev_b.active, prev_b.value
-        self.orphans = [b for b in old_behaviours.values() if b.active]
+        old_rules = {n.key: n for n in old._nodes if not n.behaviour}
+        old_sigs = {r.key: r.signature for r in old.spec.rules}
+        for node in self._nodes:
+            if node.behaviour:
+                continue
+            prev = old_rules.get(node.key)
+            if prev is not None and old_sigs.get(node.key) == self.spec.rule(node.key).signature:
+                self._take_ops(prev, node)
+                if node.key in src.rules:
+                    dst.rules[node.key] = src.rules[node.key]
+        old_behaviours = {_identity(n.behaviour): n for n in old._nodes if n.behaviour}
+        for node in self._nodes:
+            if not node.behaviour:
+                continue
+            prev = old_behaviours.pop(_identity(node.behaviour), None)
+            if prev is not None:
+                if prev.behaviour.signature == node.behaviour.signature:  # type: ignore[union-attr]
+                    self._take_ops(prev, node)
+                node.active, node.value = prev.active, prev.value
+                if node.active:
+                    for a in node.actions:
+                        self._holders.setdefault(a, set()).add(node.key)
+        for action, holders in old._holders.items():
+            outside = {h for h in holders if not h.startswith("b:")}
+            if outside:
+                self._holders.setdefault(action, set()).update(outside)
+        self._sync_actions()
+        self.orphans = [n for n in old_behaviours.values() if n.active]
         return self.evaluate_all(now)
 
-    def _take_timers(self, src: Compiled, dst: Compiled) -> None:
-        for a, b in zip(src.timers, dst.timers):
-            b.since = a.since
-            if a.since is not None and b.duration > 0:
-                self._push_timer(*b.notify.args, a.since + b.duration, b, a.since)  # type: ignore[union-attr]
+    def _take_ops(self, src: _Node, dst: _Node) -> None:
+        for a, b in zip(src.compiled.ops, dst.compiled.ops):
+            if type(a) is type(b):
+                b.restore(a.snapshot())
+        self._schedule(self._at[dst.key], dst)
 
     # -- state ---------------------------------------------------------------------------
     def rule_value(self, key: str) -> Any:
@@ -299,49 +366,94 @@ class Engine:
 
     def behaviour_rules(self, index: int) -> List[str]:
         """The rules a behaviour's condition names that are true now (what caused it)."""
-        cond = self._behaviours[index - 1].checked.cond
+        cond = self.spec.behaviours[index - 1].cond
         keys = [e.key for e in ast.walk(cond) if isinstance(e, ast.RuleRef)]
         return sorted({k for k in keys if self.store.rules.get(k) is True})
 
     def explain(self, index: int) -> Witness:
         """Why behaviour `index` (1-based) holds now: computed at its start only, off the message path."""
         if self._explainer is None:
-            self._explainer = Explainer(self.spec, self.store, lambda e: Compiler(self.store)._fn(e, []))
+            self._explainer = Explainer(self.spec, self.store, lambda e: self._compiler._fn(e, [], None))
         return self._explainer.explain(index)
 
     def active_behaviours(self) -> List[int]:
-        return [j + 1 for j, b in enumerate(self._behaviours) if b.active]
+        return sorted(int(n.key[2:]) for n in self._nodes if n.behaviour and n.active)
 
     # -- evaluation ----------------------------------------------------------------------
-    def _run(self, plan: _Plan, events: List[Event]) -> None:
-        store, now = self.store, self.store.now
-        for i in plan.rules:
-            compiled = self._rules[i]
-            value = compiled.fn()
-            key = self._keys[i]
-            old = store.rules.get(key, UNKNOWN)
-            if value is not old and value != old or key not in store.rules:
-                store.rules[key] = value
-                events.append(Event(now, "rule", rule=key, value=None if value is UNKNOWN else value))
-            self._schedule(compiled, 0, i)
-        for j in plan.behaviours:
-            b = self._behaviours[j]
-            b.value = b.compiled.fn()
-            self._schedule(b.compiled, 1, j)
-            if b.value is True and not b.active:
-                b.active = True
-                events.append(Event(now, "start", j + 1, actions=b.actions, line=b.checked.span.line,
-                                    witness=self.explain(j + 1)))
-            elif b.value is not True and b.active and not b.checked.latched:
-                b.active = False
-                events.append(Event(now, "release", j + 1, actions=b.actions, line=b.checked.span.line))
+    def _event(self, node: _Node, kind: str, witness: Optional[Witness] = None) -> Event:
+        b = node.behaviour
+        assert b is not None
+        return Event(self.store.now, kind, b.index, actions=node.actions, line=b.span.line, name=b.name,
+                     witness=witness)
 
-    def _schedule(self, compiled: Compiled, kind: int, idx: int) -> None:
-        if compiled.timed:
-            pushed = self._timed_pushed.setdefault((kind, idx), set())
-            for due in compiled.time_deadlines(self.store):
-                if due not in pushed:
-                    if len(pushed) > 64:  # forget old ones; a repeat push is only wasted work
-                        pushed.clear()
-                    pushed.add(due)
-                    heapq.heappush(self._heap, (due, next(self._seq), kind, idx, None, 0.0))
+    def _run(self, plan: Tuple[int, ...], events: List[Event]) -> None:
+        store, nodes = self.store, self._nodes
+        changed = False
+        for i in plan:
+            node = nodes[i]
+            value = node.compiled.fn()
+            if node.compiled.ops:
+                self._schedule(i, node)
+            b = node.behaviour
+            if b is None:
+                key = node.key
+                old = store.rules.get(key, UNKNOWN)
+                if value is not old and value != old or key not in store.rules:
+                    store.rules[key] = value
+                    events.append(Event(store.now, "rule", rule=key, value=None if value is UNKNOWN else value))
+                continue
+            node.value = value
+            if value is True and not node.active:
+                node.active = True
+                for a in node.actions:
+                    self._holders.setdefault(a, set()).add(node.key)
+                changed = True
+                self._sync_actions()
+                events.append(self._event(node, "start", self.explain(b.index)))
+            elif value is not True and node.active and not b.latched:
+                node.active = False
+                for a in node.actions:
+                    self._holders.get(a, set()).discard(node.key)
+                changed = True
+                self._sync_actions()
+                events.append(self._event(node, "release"))
+        del changed
+
+    def _schedule(self, idx: int, node: _Node) -> None:
+        for due, op in node.compiled.deadlines():
+            if node.pushed.get(id(op)) != due:
+                node.pushed[id(op)] = due
+                heapq.heappush(self._heap, (due, next(self._seq), idx, op))
+
+
+def _identity(b: Any) -> str:
+    """A behaviour's identity across reloads: its name, else its condition and actions."""
+    return f"name:{b.name}" if b.name else f"sig:{b.signature}"
+
+
+STAMP: Tuple[ast.PathElem, ...] = ("header", "stamp")
+
+
+def _stamp(value: Any) -> Any:
+    """header.stamp as seconds; unknown for a zero stamp or one that cannot be read."""
+    to_sec = getattr(value, "to_sec", None)  # genpy Time
+    if callable(to_sec):
+        value = float(to_sec())
+    if isinstance(value, (int, float)) and not isinstance(value, bool):
+        value = float(value)
+        return value if value > 0 and value == value else UNKNOWN
+    if isinstance(value, dict):
+        secs, nsecs = value.get("secs"), value.get("nsecs", 0)
+        if isinstance(secs, (int, float)) and isinstance(nsecs, (int, float)):
+            t = float(secs) + float(nsecs) * 1e-9
+            return t if t > 0 else UNKNOWN
+    return UNKNOWN
+
+
+def _laser_limits(msg: Any) -> Optional[Tuple[float, float]]:
+    """(range_min, range_max) of a sensor_msgs/LaserScan (REP 117), None for any other type."""
+    try:
+        lo, hi = extract(msg, ("range_min",)), extract(msg, ("range_max",))
+    except FieldError:
+        return None
+    return (lo, hi) if type(lo) is float and type(hi) is float else None

@@ -10,7 +10,7 @@ from __future__ import annotations
 import math
 from typing import Any, Tuple
 
-from ..lang.ast import PathElem, path_suffix
+from ..lang.ast import PathElem, Slice, path_suffix
 from .values import UNKNOWN
 
 
@@ -22,10 +22,19 @@ def path_text(path: Tuple[PathElem, ...]) -> str:
     return path_suffix(path).lstrip(".")
 
 
-def extract(msg: Any, path: Tuple[PathElem, ...]) -> Any:
-    """The value at `path` in `msg`; FieldError when the type has no such field."""
+def extract(msg: Any, path: Tuple[PathElem, ...], raw: bool = False) -> Any:
+    """The value at `path` in `msg`; FieldError when the type has no such field.
+
+    A path ending in a slice or `[*]` (an array term, §12) gives the tuple of its elements
+    as they are (messages stay messages): the engine reads each element's field later.
+    """
     value = msg
     for i, elem in enumerate(path):
+        if isinstance(elem, Slice):
+            if not isinstance(value, (list, tuple, bytes, bytearray)):
+                raise FieldError(f"'{path_text(path[:i])}' is not an array")
+            part = value[elem.start:elem.stop]
+            return bytes(part) if isinstance(part, (bytes, bytearray)) else tuple(part)
         if isinstance(elem, int):
             if not isinstance(value, (list, tuple, bytes, bytearray)):
                 raise FieldError(f"'{path_text(path[:i])}' is not an array")
@@ -45,7 +54,7 @@ def extract(msg: Any, path: Tuple[PathElem, ...]) -> Any:
             value = getattr(value, elem)
         except AttributeError:
             raise FieldError(f"no field '{path_text(path[:i + 1])}'") from None
-    return convert(value, path)
+    return value if raw else convert(value, path)
 
 
 def convert(value: Any, path: Tuple[PathElem, ...] = ()) -> Any:

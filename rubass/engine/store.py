@@ -19,6 +19,10 @@ class Store:
         self._arrivals: Dict[str, List[float]] = {}
         self._window: Dict[str, float] = {}
         self.nodes: Dict[str, Dict[str, Any]] = {}
+        self.stamps: Dict[str, Any] = {}  # topic -> header.stamp of its last message, seconds
+        self.rates: Dict[Tuple[str, Tuple[PathElem, ...]], Any] = {}
+        self._rate_last: Dict[Tuple[str, Tuple[PathElem, ...]], Tuple[float, Any]] = {}
+        self.laser_limits: Dict[str, Optional[Tuple[float, float]]] = {}
 
     def watch(self, topic: str, now: float, window: float = 0.0) -> None:
         """Start watching a topic (age counts from here); keep arrivals for `window` seconds."""
@@ -35,9 +39,37 @@ class Store:
             if len(arr) > 64 and arr[len(arr) // 2] < now - window:  # drop the old half at once
                 del arr[: bisect.bisect_left(arr, now - window)]
 
-    def carry_arrivals(self, other: "Store", topic: str) -> None:
-        """Keep the arrival times another store recorded for a topic (live reload)."""
+    def carry_topic(self, other: "Store", topic: str) -> None:
+        """Keep what another store knew of a topic: watch start, arrivals, stamps, rates (live reload)."""
+        self.watch_start[topic] = other.watch_start[topic]
+        if topic in other.last_arrival:
+            self.last_arrival[topic] = other.last_arrival[topic]
         self._arrivals[topic] = list(other._arrivals.get(topic, []))
+        if topic in other.stamps:
+            self.stamps[topic] = other.stamps[topic]
+        if topic in other.laser_limits:
+            self.laser_limits[topic] = other.laser_limits[topic]
+        for key in other._rate_last:
+            if key[0] == topic:
+                self._rate_last[key] = other._rate_last[key]
+                self.rates[key] = other.rates.get(key, UNKNOWN)
+
+    def arrive_rate(self, topic: str, path: Tuple[PathElem, ...], now: float, value: Any) -> None:
+        """rate(topic /t.f) (§11): the change of f per second over its last two messages."""
+        key = (topic, path)
+        last = self._rate_last.get(key)
+        self._rate_last[key] = (now, value)
+        rate: Any = UNKNOWN
+        if last is not None and type(value) is float and type(last[1]) is float and now != last[0]:
+            rate = (value - last[1]) / (now - last[0])
+            if rate != rate:
+                rate = UNKNOWN
+        self.rates[key] = rate
+
+    def stamp_age(self, topic: str) -> Any:
+        """now − header.stamp of the last message (§11); unknown before one, or for a zero stamp."""
+        stamp = self.stamps.get(topic, UNKNOWN)
+        return UNKNOWN if stamp is UNKNOWN else self.now - stamp
 
     def age(self, topic: str) -> Any:
         last = self.last_arrival.get(topic, self.watch_start.get(topic))

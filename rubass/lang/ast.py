@@ -47,12 +47,35 @@ class Name:
         return ".".join(self.parts)
 
 
-PathElem = Union[str, int]
+@dataclass(frozen=True)
+class Slice:
+    """`[A:B]` in a field path (§12): half-open, clipped, negative from the end; `[*]` is `[:]`."""
+
+    start: Optional[int] = None
+    stop: Optional[int] = None
+
+    @property
+    def text(self) -> str:
+        if self.start is None and self.stop is None:
+            return "[*]"
+        return f"[{'' if self.start is None else self.start}:{'' if self.stop is None else self.stop}]"
+
+
+PathElem = Union[str, int, Slice]
 
 
 def path_suffix(path: Tuple[PathElem, ...]) -> str:
-    """A field path as written after a topic name: `.pose.position.x`, `.ranges[0]`, `[0]`."""
-    return "".join(f"[{p}]" if isinstance(p, int) else f".{p}" for p in path)
+    """A field path as written after a topic name: `.pose.position.x`, `.ranges[0]`, `[0:90]`."""
+    return "".join(p.text if isinstance(p, Slice) else f"[{p}]" if isinstance(p, int) else f".{p}"
+                   for p in path)
+
+
+def slice_at(path: Tuple[PathElem, ...]) -> int:
+    """The position of the slice or `[*]` in a field path, -1 when it has none."""
+    for i, p in enumerate(path):
+        if isinstance(p, Slice):
+            return i
+    return -1
 
 
 @dataclass(frozen=True)
@@ -104,10 +127,32 @@ class For:
 
 
 @dataclass(frozen=True)
+class Within:
+    """`E within T` (§10): E was true at some instant of (t - T, t]."""
+
+    operand: "Expr"
+    duration: "Expr"
+    span: Span = _span()
+
+
+@dataclass(frozen=True)
+class Pair:
+    """`(x, y)`: a vertex, only inside polygon() (§13)."""
+
+    x: "Expr"
+    y: "Expr"
+    span: Span = _span()
+
+
+Point = Tuple[float, float]
+LitValue = Union[float, bool, str, Tuple[Point, ...]]  # a tuple of points: a polygon (§13)
+
+
+@dataclass(frozen=True)
 class Lit:
     """A checked constant, normalised to SI (the checker's output; never parsed)."""
 
-    value: Union[float, bool, str]
+    value: LitValue
     span: Span = _span()
 
 
@@ -119,13 +164,117 @@ class RuleRef:
     span: Span = _span()
 
 
-Expr = Union[Num, Bool, Str, Name, TopicRef, NodeRef, Call, Unary, Binary, For, Lit, RuleRef]
+# ---- checked built-ins: the checker's output for the calls of §4 and §10–14 --------------
+@dataclass(frozen=True)
+class Age:
+    topic: str
+    span: Span = _span()
+
+
+@dataclass(frozen=True)
+class StampAge:
+    topic: str
+    span: Span = _span()
+
+
+@dataclass(frozen=True)
+class Frequency:
+    topic: str
+    window: float = 1.0
+    span: Span = _span()
+
+
+@dataclass(frozen=True)
+class NodeStat:
+    """alive(), cpu() or memory() of a node: attr is the function's name."""
+
+    node: str
+    attr: str
+    span: Span = _span()
+
+
+@dataclass(frozen=True)
+class Rate:
+    """rate(topic /t.f): the field's change per second over the last two messages (§11)."""
+
+    ref: TopicRef
+    span: Span = _span()
+
+
+@dataclass(frozen=True)
+class ArrayFn:
+    """min/max/len over an array term: `ref` reads the array (its path ends at the array or its
+    slice); `elem` is the field path read in each element (`status[*].level`: ('level',))."""
+
+    func: str
+    ref: TopicRef
+    elem: Tuple[PathElem, ...] = ()
+    span: Span = _span()
+
+
+@dataclass(frozen=True)
+class Elem:
+    """Inside a quantifier: the field `path` of the element being visited."""
+
+    path: Tuple[PathElem, ...] = ()
+    span: Span = _span()
+
+
+@dataclass(frozen=True)
+class Quant:
+    """any/all/count(body) over the elements of the array that `ref` reads (§12)."""
+
+    func: str
+    ref: TopicRef
+    body: "Expr"
+    span: Span = _span()
+
+
+@dataclass(frozen=True)
+class Latch:
+    """latch(SET, RESET): an SR latch with set priority, in Kleene logic (§10)."""
+
+    set: "Expr"
+    reset: "Expr"
+    span: Span = _span()
+
+
+@dataclass(frozen=True)
+class Active:
+    """active(ACTION): the declared action is active (§14)."""
+
+    action: str
+    span: Span = _span()
+
+
+@dataclass(frozen=True)
+class Zone:
+    """inside(X, Y, AREA) (func 'inside') or distance(X, Y, AREA) (func 'distance') (§13)."""
+
+    func: str
+    x: "Expr"
+    y: "Expr"
+    polygon: Tuple[Point, ...]
+    span: Span = _span()
+
+
+Expr = Union[Num, Bool, Str, Name, TopicRef, NodeRef, Call, Unary, Binary, For, Within, Pair, Lit, RuleRef,
+             Age, StampAge, Frequency, NodeStat, Rate, ArrayFn, Elem, Quant, Latch, Active, Zone]
 
 
 # ---- declarations ----------------------------------------------------------------------
 @dataclass(frozen=True)
 class Ident:
     name: str
+    span: Span = _span()
+
+
+@dataclass(frozen=True)
+class Attr:
+    """`@id("SR-3")`: a traceability attribute (§15)."""
+
+    name: str
+    args: Tuple[str, ...]
     span: Span = _span()
 
 
@@ -153,6 +302,7 @@ class Rule:
     name: Ident
     expr: Expr
     span: Span = _span()
+    attrs: Tuple[Attr, ...] = ()
 
 
 @dataclass(frozen=True)
@@ -161,6 +311,7 @@ class Entity:
     nodes: Tuple[Ident, ...]
     rules: Tuple[Rule, ...]
     span: Span = _span()
+    attrs: Tuple[Attr, ...] = ()
 
 
 @dataclass(frozen=True)
@@ -175,6 +326,8 @@ class Behaviour:
     cond: Expr
     actions: Tuple[ActionCall, ...]
     span: Span = _span()
+    name: Optional[Ident] = None  # `name: if (…)` (§14)
+    attrs: Tuple[Attr, ...] = ()
 
 
 Decl = Union[Import, ActionDecl, Const, Entity, Behaviour]
@@ -213,6 +366,16 @@ def children(expr: Expr) -> Tuple[Expr, ...]:
         return (expr.operand,)
     if isinstance(expr, Binary):
         return (expr.left, expr.right)
-    if isinstance(expr, For):
+    if isinstance(expr, (For, Within)):
         return (expr.operand, expr.duration)
+    if isinstance(expr, Pair):
+        return (expr.x, expr.y)
+    if isinstance(expr, (Rate, ArrayFn)):
+        return (expr.ref,)
+    if isinstance(expr, Quant):
+        return (expr.ref, expr.body)
+    if isinstance(expr, Latch):
+        return (expr.set, expr.reset)
+    if isinstance(expr, Zone):
+        return (expr.x, expr.y)
     return ()

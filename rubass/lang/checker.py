@@ -10,17 +10,21 @@ from typing import Dict, FrozenSet, List, Optional, Sequence, Set, Tuple
 
 from . import ast
 from .errors import Diagnostic, did_you_mean
+from .fieldmodel import FieldModel
 from .fmt import format_expr
 from .library import ActionDef, load_library
+from .attributes import AttrChecker
 from .model import BoundAction, CheckedBehaviour, CheckedRule, CheckedSpec, TopicUse, Value
 from .paths import PathError, resolve
 from .source import SourceSet, Span
 from .typecheck import ANY, ExprChecker, Resolution, Scope, Ty
 
+STAMP_PATH: Tuple[ast.PathElem, ...] = ("header", "stamp")
+
 
 class _Checker:
-    def __init__(self, spec: ast.Spec, sources: SourceSet) -> None:
-        self.spec, self.sources = spec, sources
+    def __init__(self, spec: ast.Spec, sources: SourceSet, model: Optional[FieldModel] = None) -> None:
+        self.spec, self.sources, self.model = spec, sources, model
         self.diags: List[Diagnostic] = []
         self.warnings: List[Diagnostic] = []
         self.consts: Dict[str, ast.Const] = {}
@@ -29,6 +33,10 @@ class _Checker:
         self.entities: Dict[str, ast.Entity] = {}
         self.rule_asts: Dict[str, ast.Rule] = {}
         self.used_rules: Dict[str, Set[str]] = {}
+        self.declared_names: FrozenSet[str] = frozenset(
+            i.name for d in spec.decls if isinstance(d, ast.ActionDecl) for i in d.names)
+        self.active_uses: Dict[str, Set[str]] = {}  # rule key or 'b:N' -> actions its active() names
+        self.attrs = AttrChecker(self.diags)
 
     def error(self, span: Span, msg: str) -> None:
         self.diags.append(Diagnostic(span, msg))
@@ -37,6 +45,13 @@ class _Checker:
     def collect(self) -> None:
         top: Dict[str, Span] = {}
         for d in self.spec.decls:
+            if isinstance(d, ast.Behaviour) and d.name is not None:
+                if d.name.name in top:
+                    self.error(d.name.span, f"duplicate name '{d.name.name}' (a behaviour); first defined at "
+                                            f"{top[d.name.name]}")
+                else:
+                    top[d.name.name] = d.name.span
+                continue
             if isinstance(d, (ast.Const, ast.Entity)):
                 kind = "constant" if isinstance(d, ast.Const) else "entity"
                 if d.name.name in top:
@@ -103,7 +118,7 @@ class _Checker:
 
     def _rule(self, key: str, user: Optional[str]) -> Resolution:
         if user is not None:
-            self.used_rules.setdefault(user, set()).add(key)
+            self.used_rules.setdefault(user, set()).add(key)  # user: a rule key, or 'b:N' for behaviour N
         return ("rule", ast.RuleRef(key), Ty("bool"))
 
     def const_value(self, name: str) -> Tuple[ast.Lit, Ty]:
@@ -135,7 +150,9 @@ class _Checker:
                 key = f"{ent.name.name}.{r.name.name}"
                 if self.rule_asts.get(key) is not r:
                     continue
-                scope = Scope(self.resolver(ent.name.name, key), nodes=nodes, entity=ent.name.name)
+                uses = self.active_uses.setdefault(key, set())
+                scope = Scope(self.resolver(ent.name.name, key), nodes=nodes, entity=ent.name.name,
+                              actions=self.declared_names, active_uses=uses, model=self.model)
                 checked[key] = ExprChecker(scope, self.diags).condition(r.expr, f"rule '{r.name.name}'")
         return checked
 
@@ -159,6 +176,50 @@ class _Checker:
 
         for key in self.rule_asts:
             visit(key, [])
+        return done
+
+    def evaluation_order(self, behaviours: List[CheckedBehaviour]) -> List[str]:
+        """Rules ('entity.rule') and behaviours ('b:N') in one dependency order (§14): what an
+        expression uses comes before it, and a behaviour comes before every active() of its
+        actions. A behaviour that depends on active() of one of its own actions is an error."""
+        starters: Dict[str, List[str]] = {}
+        for b in behaviours:
+            for a in b.actions:
+                starters.setdefault(a.name, []).append(f"b:{b.index}")
+        deps: Dict[str, List[str]] = {}
+        for user in list(self.rule_asts) + [f"b:{b.index}" for b in behaviours]:
+            d = sorted(self.used_rules.get(user, ()))
+            for act in sorted(self.active_uses.get(user, ())):
+                d += [f"active({act})"]
+            deps[user] = d
+        for act, who in starters.items():
+            deps[f"active({act})"] = who
+        spans = {f"b:{b.index}": b.span for b in behaviours}
+        names = {f"b:{b.index}": b.label for b in behaviours}
+        done: List[str] = []
+        state: Dict[str, int] = {}
+
+        def visit(node: str, path: List[str]) -> None:
+            if state.get(node) == 2:
+                return
+            if state.get(node) == 1:
+                cycle = path[path.index(node):] + [node]
+                if any(c.startswith("active(") for c in cycle):
+                    owner = next(c for c in cycle if c.startswith("b:"))
+                    chain = " -> ".join(names.get(c, c) for c in cycle[cycle.index(owner):] + cycle[1:cycle.index(owner) + 1]) \
+                        if cycle[0] != owner else " -> ".join(names.get(c, c) for c in cycle)
+                    self.error(spans[owner], f"{names[owner]} depends on active() of one of its own actions, so it "
+                                             f"could hold itself on: {chain}")
+                return
+            state[node] = 1
+            for dep in deps.get(node, ()):
+                visit(dep, path + [node])
+            state[node] = 2
+            if not node.startswith("active("):
+                done.append(node)
+
+        for node in list(self.rule_asts) + [f"b:{b.index}" for b in behaviours]:
+            visit(node, [])
         return done
 
     # -- actions -------------------------------------------------------------------------
@@ -222,7 +283,9 @@ class _Checker:
             if not isinstance(d, ast.Behaviour):
                 continue
             index = len(out) + 1
-            scope = Scope(self.resolver(None, None))
+            uses = self.active_uses.setdefault(f"b:{index}", set())
+            user = f"b:{index}"
+            scope = Scope(self.resolver(None, user), actions=self.declared_names, active_uses=uses, model=self.model)
             cond = ExprChecker(scope, self.diags).condition(d.cond, "the condition of 'if'")
             bound: List[BoundAction] = []
             for call in d.actions:
@@ -243,16 +306,20 @@ class _Checker:
             if not d.actions:
                 self.warnings.append(Diagnostic(d.span, "this behaviour has no actions", "warning"))
             sig = f"if ({format_expr(cond)}) then {{{' '.join(a.name + repr(a.args) for a in bound)}}}"
-            out.append(CheckedBehaviour(index, cond, tuple(bound), d.span, sig))
+            name = d.name.name if d.name is not None else ""
+            out.append(CheckedBehaviour(index, cond, tuple(bound), d.span, sig, name,
+                                        self.attrs.own(d.attrs, "behaviour")))
         for name, span in declared.items():
             if name not in used:
                 self.warnings.append(Diagnostic(span, f"action '{name}' is declared but never used", "warning"))
         return out
 
 
-def check(spec: ast.Spec, sources: SourceSet, extra_libraries: Sequence[str] = ()) -> Tuple[Optional[CheckedSpec], List[Diagnostic], List[Diagnostic]]:
-    """Check a parsed spec; returns (checked spec or None, errors, warnings)."""
-    c = _Checker(spec, sources)
+def check(spec: ast.Spec, sources: SourceSet, extra_libraries: Sequence[str] = (),
+          model: Optional[FieldModel] = None) -> Tuple[Optional[CheckedSpec], List[Diagnostic], List[Diagnostic]]:
+    """Check a parsed spec, against a system model when one is given; returns (checked spec or
+    None, errors, warnings)."""
+    c = _Checker(spec, sources, model)
     try:
         c.collect()
         for name in c.consts:
@@ -262,6 +329,8 @@ def check(spec: ast.Spec, sources: SourceSet, extra_libraries: Sequence[str] = (
         library, loaded = c.load_libraries(extra_libraries)
         declared = c.check_actions(library, loaded)
         behaviours = c.check_behaviours(declared, library)
+        evaluation = c.evaluation_order(behaviours)
+        c.attrs.check_rules(c.entities)
     except RecursionError:
         c.error(Span(spec.file, 1, 1), "expressions are nested too deeply to check")
     if c.diags:
@@ -272,7 +341,7 @@ def check(spec: ast.Spec, sources: SourceSet, extra_libraries: Sequence[str] = (
     topics, nodes = _uses([r.expr for r in rules] + [b.cond for b in behaviours])
     consts = {n: lit.value for n, (lit, _) in c.const_values.items()}
     return (CheckedSpec(spec.file, spec, rules, behaviours, consts, library, topics, nodes, loaded,
-                        c.warnings, sources), [], c.warnings)
+                        c.warnings, sources, evaluation), [], c.warnings)
 
 
 def _build_rules(c: _Checker, checked: Dict[str, ast.Expr], order: List[str]) -> List[CheckedRule]:
@@ -283,7 +352,8 @@ def _build_rules(c: _Checker, checked: Dict[str, ast.Expr], order: List[str]) ->
         text = format_expr(checked[key])
         sigs[key] = text + "".join(f" [{d}: {sigs[d]}]" for d in sorted(deps))
         ent, name = key.split(".")
-        rules.append(CheckedRule(key, ent, name, checked[key], c.rule_asts[key].span, deps, sigs[key]))
+        rules.append(CheckedRule(key, ent, name, checked[key], c.rule_asts[key].span, deps, sigs[key],
+                                 c.attrs.rule_attrs(c.entities[ent], c.rule_asts[key])))
     return rules
 
 
@@ -305,6 +375,10 @@ def _uses(exprs: Sequence[ast.Expr]) -> Tuple[Dict[str, TopicUse], FrozenSet[str
             paths.setdefault(e.topic, set())
             if e.path:
                 paths[e.topic].add(e.path)
-        elif isinstance(e, ast.NodeRef):
+        elif isinstance(e, (ast.Age, ast.Frequency, ast.StampAge)):
+            paths.setdefault(e.topic, set())
+            if isinstance(e, ast.StampAge):
+                paths[e.topic].add(STAMP_PATH)
+        elif isinstance(e, ast.NodeStat):
             nodes.add(e.node)
     return {t: TopicUse(t, frozenset(p)) for t, p in paths.items()}, frozenset(nodes)

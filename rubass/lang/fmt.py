@@ -1,6 +1,7 @@
 """The pretty-printer: one canonical layout, comments kept, parse(fmt(x)) == parse(x)."""
 from __future__ import annotations
 
+from dataclasses import replace
 from typing import Dict, List, Optional, Tuple
 
 from . import ast
@@ -23,7 +24,7 @@ def _quote(s: str) -> str:
 
 
 def _prec(e: ast.Expr) -> int:
-    if isinstance(e, ast.For):
+    if isinstance(e, (ast.For, ast.Within)):
         return 1
     if isinstance(e, ast.Binary):
         return _PREC[e.op]
@@ -34,19 +35,29 @@ def _prec(e: ast.Expr) -> int:
     return _ATOM
 
 
-def format_expr(e: ast.Expr, need: int = 0) -> str:
-    """An expression on one line, parenthesised only where the grammar needs it."""
-    text = _expr(e)
+def format_expr(e: ast.Expr, need: int = 0, arr: Optional[ast.TopicRef] = None) -> str:
+    """An expression on one line, parenthesised only where the grammar needs it.
+
+    Checked nodes print as the source that means them (Age as `age(topic /t)`, a polygon
+    constant as `polygon(…)`); `arr` is the array an enclosing quantifier runs over."""
+    text = _expr(e, arr)
     return f"({text})" if _prec(e) < need else text
 
 
-def _expr(e: ast.Expr) -> str:
+def _args(*parts: str) -> str:
+    return ", ".join(parts)
+
+
+def _expr(e: ast.Expr, arr: Optional[ast.TopicRef] = None) -> str:
+    f = lambda x, need=0: format_expr(x, need, arr)  # noqa: E731
     if isinstance(e, ast.Num):
         return format_number(e.value) + (f" {e.unit}" if e.unit else "")
     if isinstance(e, ast.Lit):
         v = e.value
         if isinstance(v, bool):
             return "true" if v else "false"
+        if isinstance(v, tuple):
+            return f"polygon({_args(*(f'({format_number(x)}, {format_number(y)})' for x, y in v))})"
         return _quote(v) if isinstance(v, str) else format_number(v)
     if isinstance(e, ast.Bool):
         return "true" if e.value else "false"
@@ -61,28 +72,66 @@ def _expr(e: ast.Expr) -> str:
     if isinstance(e, ast.NodeRef):
         return f"node {e.node}"
     if isinstance(e, ast.Call):
-        return f"{e.func}({', '.join(format_expr(a) for a in e.args)})"
+        return f"{e.func}({', '.join(f(a) for a in e.args)})"
     if isinstance(e, ast.Unary):
         if e.op == "not":
-            return f"not {format_expr(e.operand, 4)}"
-        return f"-{format_expr(e.operand, 8)}"
+            return f"not {f(e.operand, 4)}"
+        return f"-{f(e.operand, 8)}"
     if isinstance(e, ast.Binary):
         p = _PREC[e.op]
         left_need = p + 1 if p == 5 else p
-        return f"{format_expr(e.left, left_need)} {e.op} {format_expr(e.right, p + 1)}"
-    if isinstance(e, ast.For):
-        return f"{format_expr(e.operand, 8)} for {format_expr(e.duration, 8)}"
+        return f"{f(e.left, left_need)} {e.op} {f(e.right, p + 1)}"
+    if isinstance(e, (ast.For, ast.Within)):
+        word = "for" if isinstance(e, ast.For) else "within"
+        operand = f(e.operand) if _prec(e.operand) == 1 else f(e.operand, 8)  # `A for 1 s within 2 s`
+        return f"{operand} {word} {f(e.duration, 8)}"
+    if isinstance(e, ast.Pair):
+        return f"({f(e.x)}, {f(e.y)})"
+    return _checked(e, arr)
+
+
+def _checked(e: ast.Expr, arr: Optional[ast.TopicRef]) -> str:
+    """The checked built-ins, as their source."""
+    f = lambda x: format_expr(x, 0, arr)  # noqa: E731
+    if isinstance(e, ast.Age):
+        return f"age(topic {e.topic})"
+    if isinstance(e, ast.StampAge):
+        return f"stamp_age(topic {e.topic})"
+    if isinstance(e, ast.Frequency):
+        window = "" if e.window == 1.0 else f", {format_number(e.window)} s"
+        return f"frequency(topic {e.topic}{window})"
+    if isinstance(e, ast.NodeStat):
+        return f"{e.attr}(node {e.node})"
+    if isinstance(e, ast.Rate):
+        return f"rate({f(e.ref)})"
+    if isinstance(e, ast.ArrayFn):
+        return f"{e.func}(topic {e.ref.topic}{ast.path_suffix(e.ref.path + e.elem)})"
+    if isinstance(e, ast.Elem):
+        assert arr is not None, "an element outside its quantifier"
+        return f"topic {arr.topic}{ast.path_suffix(arr.path + e.path)}"
+    if isinstance(e, ast.Quant):
+        return f"{e.func}({format_expr(e.body, 0, e.ref)})"
+    if isinstance(e, ast.Latch):
+        return f"latch({f(e.set)}, {f(e.reset)})"
+    if isinstance(e, ast.Active):
+        return f"active({e.action})"
+    if isinstance(e, ast.Zone):
+        return f"{e.func}({f(e.x)}, {f(e.y)}, {_expr(ast.Lit(e.polygon))})"
     raise TypeError(f"cannot format {type(e).__name__}")
 
 
 def _wrapped(e: ast.Expr, indent: int) -> str:
     """A long expression broken before its top-level 'and'/'or' operators."""
-    if isinstance(e, ast.For):
+    if isinstance(e, (ast.For, ast.Within)):
+        word = "for" if isinstance(e, ast.For) else "within"
         inner = e.operand
-        body = _wrapped(inner, indent + 1) if _prec(inner) < 8 else format_expr(inner)
-        if _prec(inner) < 8:
-            body = f"({body})"
-        return f"{body} for {format_expr(e.duration, 8)}"
+        if _prec(inner) == 1:
+            body = _wrapped(inner, indent)
+        else:
+            body = _wrapped(inner, indent + 1) if _prec(inner) < 8 else format_expr(inner)
+            if _prec(inner) < 8:
+                body = f"({body})"
+        return f"{body} {word} {format_expr(e.duration, 8)}"
     return _chain(e, indent)
 
 
@@ -172,7 +221,16 @@ def format_spec(spec: ast.Spec, text: Optional[str] = None) -> str:
     return "\n".join(out) + "\n" if out else ""
 
 
+def _attrs(attrs: Tuple[ast.Attr, ...]) -> List[str]:
+    """Attributes on one line before what they annotate (none: no line)."""
+    if not attrs:
+        return []
+    return [" ".join(f"@{a.name}({', '.join(_quote(x) for x in a.args)})" for a in attrs)]
+
+
 def _decl(d: ast.Decl, com: _Comments) -> List[str]:
+    if isinstance(d, (ast.Entity, ast.Behaviour)) and d.attrs:
+        return _attrs(d.attrs) + _decl(replace(d, attrs=()), com)
     if isinstance(d, ast.Import):
         return [f"import {_quote(d.path)};"]
     if isinstance(d, ast.ActionDecl):
@@ -194,6 +252,7 @@ def _entity(d: ast.Entity, com: _Comments) -> List[str]:
             lines.append("    " + h.lstrip("&"))
     for r in d.rules:
         lines.extend("    " + c for c in com.leading.get(r.span.start, []))
+        lines.extend("    " + a for a in _attrs(r.attrs))
         one = f"    {r.name.name}: {format_expr(r.expr)};"
         if len(one) > WIDTH:
             body = _wrapped(r.expr, 6).split("\n")
@@ -208,10 +267,11 @@ def _entity(d: ast.Entity, com: _Comments) -> List[str]:
 def _behaviour(d: ast.Behaviour) -> List[str]:
     calls = [f"{a.name.name}({', '.join(format_expr(x) for x in a.args)});" if a.args else f"{a.name.name};"
              for a in d.actions]
-    head = f"if ({format_expr(d.cond)}) then {{"
+    label = f"{d.name.name}: " if d.name is not None else ""
+    head = f"{label}if ({format_expr(d.cond)}) then {{"
     one = f"{head} {' '.join(calls)} }}" if calls else f"{head} }}"
     if len(one) <= WIDTH:
         return [one]
     if len(head) > WIDTH:
-        head = f"if ({_wrapped(d.cond, 4)}) then {{"
+        head = f"{label}if ({_wrapped(d.cond, 4)}) then {{"
     return head.split("\n") + ["  " + c for c in calls] + ["}"]

@@ -15,15 +15,17 @@ from .errors import Diagnostic, SpecError
 from .source import Source, SourceSet, Span
 
 KEYWORDS = frozenset(
-    "action primitive entity rules if then topic node and or not for true false const import".split()
+    "action primitive entity rules if then topic node and or not for true false const import within".split()
 )
 FUNCTIONS = frozenset(
-    "abs sqrt min max hypot len frequency age alive cpu memory".split()
+    "abs sqrt min max hypot len frequency age alive cpu memory "  # version 1
+    "rate stamp_age any all count polygon inside distance active latch".split()  # version 2 (§10–14)
 )
 
 _IDENT_RE = r"[A-Za-z_][A-Za-z0-9_]*"
 _GRAPH_RE = rf"~?/?{_IDENT_RE}(?:/{_IDENT_RE})*"
-_PATH_RE = rf"(?:\.{_IDENT_RE}|\[\s*-?\d+\s*\])*"
+_INDEX_RE = r"\[\s*-?\d+\s*\]|\[\s*\*\s*\]|\[\s*-?\d*\s*:\s*-?\d*\s*\]"
+_PATH_RE = rf"(?:\.{_IDENT_RE}|{_INDEX_RE})*"
 _NUM_RE = r"(?:\d+\.\d*|\.\d+|\d+)(?:[eE][-+]?\d+)?"
 _UNIT_RE = r"%|[A-Za-z]+(?:/[A-Za-z]+(?:\^[0-9]+)?)?(?![A-Za-z0-9_])"
 
@@ -130,16 +132,21 @@ def _unary(s: str, loc: int, toks: Any) -> Any:
 
 
 def _for(s: str, loc: int, toks: Any) -> Any:
+    """`E for T within U …`: postfix, applied left to right (§10)."""
     items = list(toks)
     expr = items[0]
     for i in range(1, len(items), 2):
-        expr = ast.For(expr, items[i + 1], span=_span(items[i].loc))
+        node = ast.For if items[i].text == "for" else ast.Within
+        expr = node(expr, items[i + 1], span=_span(items[i].loc))
     return expr
 
 
 def _number(s: str, loc: int, toks: Any) -> Any:
     unit = toks[1] if len(toks) > 1 else None
-    return ast.Num(float(toks[0]), unit, span=_span(loc))
+    value = float(toks[0])
+    if value == float("inf"):
+        _fail(s, loc, f"the number '{toks[0]}' is too large (the largest is about 1.8e308)")
+    return ast.Num(value, unit, span=_span(loc))
 
 
 _ESCAPES = {'"': '"', "\\": "\\"}
@@ -168,8 +175,20 @@ def _topic(s: str, loc: int, toks: Any) -> Any:
     m = re.match(_GRAPH_RE, text)
     assert m is not None
     path: List[ast.PathElem] = []
-    for part in re.findall(rf"\.({_IDENT_RE})|\[\s*(-?\d+)\s*\]", text[m.end():]):
-        path.append(part[0] if part[0] else int(part[1]))
+    slices = 0
+    for part in re.finditer(rf"\.({_IDENT_RE})|\[([^\]]*)\]", text[m.end():]):
+        if part.group(1):
+            path.append(part.group(1))
+            continue
+        inner = re.sub(r"\s", "", part.group(2))
+        if inner == "*" or ":" in inner:
+            slices += 1
+            if slices > 1:
+                _fail(s, loc, "a field path can run over one array only: one '[*]' or '[A:B]'")
+            a, _, b = inner.partition(":") if inner != "*" else ("", "", "")
+            path.append(ast.Slice(int(a) if a else None, int(b) if b else None))
+        else:
+            path.append(int(inner))
     return ast.TopicRef(m.group(0), tuple(path), span=_span(loc))
 
 
@@ -273,8 +292,16 @@ def _build() -> pp.ParserElement:
         lambda s, loc, t: ast.Call(t[0], tuple(t[1:]), span=_span(loc)),
     )
     name = _action(pp.Regex(rf"{_IDENT_RE}(?:\.{_IDENT_RE})?").addCondition(_not_keyword), _name)
+
+    def paren(s: str, loc: int, toks: Any) -> Any:
+        if len(toks) == 1:
+            return toks[0]
+        return ast.Pair(toks[0], toks[1], span=_span(loc))
+
+    comma = pp.Suppress(_lit(","))
+    parens = _action(_seq(LPAR, expr, pp.Optional(comma + expr), RPAR), paren)
     primary = (
-        true | false | number | string | topic | node | call | name | _seq(LPAR, expr, RPAR)
+        true | false | number | string | topic | node | call | name | parens
     ).setName("expression")
     unary = pp.Forward().setName("expression")
     unary <<= (_action(op("-") + unary, _unary) | primary).setName("expression")
@@ -283,14 +310,18 @@ def _build() -> pp.ParserElement:
                     lambda s, loc, t: [_Op(t[0], loc)])
     operand = nots + unary
     flat = _action(operand + pp.ZeroOrMore(_seq(binop, operand)), _climb)
-    for_hint = _action(
-        op("and", "or"),
-        lambda s, loc, t: _fail(
-            s, loc, f"'for' applies to everything on its left; to combine its result, put it in "
-                    f"parentheses: '(A for T) {t[0].text} B'"),
-    )
+    def hint(word: str) -> pp.ParserElement:
+        return _action(
+            op("and", "or"),
+            lambda s, loc, t: _fail(
+                s, loc, f"'{word}' applies to everything on its left; to combine its result, put it in "
+                        f"parentheses: '(A {word} T) {t[0].text} B'"),
+        )
+
     duration = unary.copy().setName("duration (e.g. 0.4 s)")
-    for_expr = _action(flat + pp.ZeroOrMore(_seq(op("for"), duration, pp.Optional(for_hint))), _for)
+    postfix = _seq(op("for"), duration, pp.Optional(hint("for"))) | \
+        _seq(op("within"), duration, pp.Optional(hint("within")))
+    for_expr = _action(flat + pp.ZeroOrMore(postfix), _for)
     expr <<= for_expr
 
     def stmt(el: pp.ParserElement, fn: Callable[[Span, List[Any]], Any]) -> pp.ParserElement:
@@ -312,21 +343,30 @@ def _build() -> pp.ParserElement:
     const_decl = stmt(
         _seq(_kw("const"), ident_node, pp.Suppress(_lit("=")).setName("'='"), expr, SEMI),
         lambda sp, t: ast.Const(t[0], t[1], span=sp))
-    rule = stmt(_seq(ident_node, COLON, expr, SEMI, commit_after=2), lambda sp, t: ast.Rule(t[0], t[1], span=sp))
+    attr = _action(
+        _seq(_lit("@"), pp.Regex(_IDENT_RE).setName("attribute name"), LPAR,
+             pp.Optional(pp.delimitedList(string)), RPAR.copy().setName("')' or a string argument")),
+        lambda s, loc, t: ast.Attr(t[1], tuple(a.value for a in t[2:]), span=_span(loc)))
+    attrs = pp.Group(pp.ZeroOrMore(attr))
+    rule = stmt(attrs + _seq(ident_node, COLON, expr, SEMI, commit_after=2),
+                lambda sp, t: ast.Rule(t[1], t[2], span=sp, attrs=tuple(t[0])))
     node_name = _action(pp.Regex(_GRAPH_RE).setName("node name"), _ident)
     header = pp.Group(pp.Optional(_seq(COLON, pp.delimitedList(node_name))))
     entity = stmt(
-        _seq(_kw("entity"), ident_node, header, pp.Optional(pp.Suppress(_lit(";"))),
-             LBRACE, pp.Suppress(_kw("rules")), COLON, pp.Group(pp.ZeroOrMore(rule)),
-             RBRACE.copy().setName("'}' or a rule 'name: expression;'"), pp.Optional(SEMI)),
-        lambda sp, t: ast.Entity(t[0], tuple(t[1]), tuple(t[2]), span=sp))
+        attrs + _seq(_kw("entity"), ident_node, header, pp.Optional(pp.Suppress(_lit(";"))),
+                     LBRACE, pp.Suppress(_kw("rules")), COLON, pp.Group(pp.ZeroOrMore(rule)),
+                     RBRACE.copy().setName("'}' or a rule 'name: expression;'"), pp.Optional(SEMI)),
+        lambda sp, t: ast.Entity(t[1], tuple(t[2]), tuple(t[3]), span=sp, attrs=tuple(t[0])))
     args = pp.Group(pp.Optional(_seq(LPAR, pp.Optional(pp.delimitedList(expr)), RPAR)))
     action_call = stmt(
         _seq(ident_node, args, SEMI, commit_after=2), lambda sp, t: ast.ActionCall(t[0], tuple(t[1]), span=sp))
+    label_name = _action(pp.Regex(_IDENT_RE).setName("name").addCondition(_not_keyword), _ident)
+    label = pp.Group(pp.Optional(label_name + COLON + pp.FollowedBy(_kw("if"))))
     behaviour = stmt(
-        _seq(_kw("if"), LPAR, expr, RPAR, _kw("then"), LBRACE, pp.Group(pp.ZeroOrMore(action_call)),
-             RBRACE.copy().setName("'}' or an action 'name;'"), pp.Optional(SEMI)),
-        lambda sp, t: ast.Behaviour(t[0], tuple(t[1]), span=sp))
+        attrs + label + _seq(_kw("if"), LPAR, expr, RPAR, _kw("then"), LBRACE, pp.Group(pp.ZeroOrMore(action_call)),
+                             RBRACE.copy().setName("'}' or an action 'name;'"), pp.Optional(SEMI)),
+        lambda sp, t: ast.Behaviour(t[2], tuple(t[3]), span=sp, name=t[1][0] if len(t[1]) else None,
+                                    attrs=tuple(t[0])))
     decl = import_stmt | action_decl | const_decl | entity | behaviour
     end = pp.StringEnd().setName("a declaration (import, action, const, entity or if)")
     spec = _seq(pp.ZeroOrMore(decl), end)

@@ -5,23 +5,25 @@ from typing import Optional, Sequence
 
 from .checker import check
 from .errors import SpecError
+from .fieldmodel import FieldModel
 from .grammar import parse_source
 from .model import CheckedSpec
 from .source import Source, SourceSet
 from .sourcefile import read_source
 
 
-def load_spec(path: str, extra_libraries: Sequence[str] = ()) -> CheckedSpec:
+def load_spec(path: str, extra_libraries: Sequence[str] = (), model: Optional[FieldModel] = None) -> CheckedSpec:
     """A checked spec, or SpecError carrying every error found (warnings stay on the result)."""
     sources = SourceSet()
     src, diag = read_source(path)
     if src is None:
         assert diag is not None
         raise SpecError([diag], sources)
-    return check_source(src, extra_libraries, sources)
+    return check_source(src, extra_libraries, sources, model)
 
 
-def check_source(src: Source, extra_libraries: Sequence[str] = (), sources: Optional[SourceSet] = None) -> CheckedSpec:
+def check_source(src: Source, extra_libraries: Sequence[str] = (), sources: Optional[SourceSet] = None,
+                 model: Optional[FieldModel] = None) -> CheckedSpec:
     """Parse and check text already read (the file name in src anchors relative imports)."""
     sources = sources or SourceSet()
     sources.add(src)
@@ -29,7 +31,7 @@ def check_source(src: Source, extra_libraries: Sequence[str] = (), sources: Opti
         spec = parse_source(src)
     except SpecError as exc:
         raise SpecError(exc.diagnostics, sources) from None
-    checked, errors, _ = check(spec, sources, extra_libraries)
+    checked, errors, _ = check(spec, sources, extra_libraries, model)
     if checked is None:
         raise SpecError(errors, sources)
     return checked

@@ -11,6 +11,9 @@ from .source import Span, SourceSet
 
 Value = Union[float, bool, str]
 
+# Traceability attributes (LANGUAGE.md §15): 'id', 'hazard', 'title', 'ref' -> their strings.
+Attrs = Dict[str, Tuple[str, ...]]
+
 
 @dataclass(frozen=True)
 class CheckedRule:
@@ -23,6 +26,7 @@ class CheckedRule:
     span: Span
     rule_deps: FrozenSet[str]
     signature: str  # canonical text of the rule and of every rule it uses (for live reload)
+    attrs: Attrs = field(default_factory=dict)  # its own, else its entity's (§15)
 
 
 @dataclass(frozen=True)
@@ -44,6 +48,13 @@ class CheckedBehaviour:
     actions: Tuple[BoundAction, ...]
     span: Span
     signature: str
+    name: str = ""  # `name: if (…)` (§14); "" for an unnamed behaviour
+    attrs: Attrs = field(default_factory=dict)
+
+    @property
+    def label(self) -> str:
+        """How events, tests and reports name it: its name, else 'behaviour N'."""
+        return self.name or f"behaviour {self.index}"
 
     @property
     def latched(self) -> bool:
@@ -77,6 +88,8 @@ class CheckedSpec:
     libraries: List[str]
     warnings: List[Diagnostic] = field(default_factory=list)
     sources: SourceSet = field(default_factory=SourceSet)
+    # rules ('entity.rule') and behaviours ('b:N') in one dependency order (§14)
+    evaluation: List[str] = field(default_factory=list)
 
     def field_readers(self) -> Dict[str, Dict[Tuple[ast.PathElem, ...], List[str]]]:
         """topic -> field path -> who reads it ("rule 'e.r'", "behaviour 2 (line 9)"), for errors."""
@@ -90,6 +103,13 @@ class CheckedSpec:
                     if owner not in users:
                         users.append(owner)
         return out
+
+    def behaviour(self, name: str) -> CheckedBehaviour:
+        """A behaviour by its name or its 1-based number."""
+        for b in self.behaviours:
+            if b.name == name or str(b.index) == name:
+                return b
+        raise KeyError(name)
 
     def rule(self, key: str) -> CheckedRule:
         for r in self.rules:

@@ -4,16 +4,19 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, replace
-from typing import Callable, List, Optional, Tuple, Union
+from typing import Any, Callable, FrozenSet, List, Optional, Set, Tuple, Union
 
 from . import ast
+from .builtins import BuiltinChecks
 from .errors import Diagnostic, did_you_mean
+from .fieldmodel import FieldModel
 from .grammar import FUNCTIONS
+from .ops import BINARY, SCALAR_FUNCTIONS, UNARY, scalar_fn
 from .source import Span
-from .units import (DIMENSIONLESS, FREQUENCY, MEMORY, TIME, UNITS, Dimension, dim_mul,
-                    dim_sqrt, dimension_name)
+from .units import DIMENSIONLESS, ODD, TIME, UNITS, Dimension, dim_mul, dim_sqrt, dimension_name
+from .values import UNKNOWN
 
-Value = Union[float, bool, str]
+Value = ast.LitValue
 
 
 @dataclass(frozen=True)
@@ -24,7 +27,7 @@ class Ty:
     written without a unit, which adopts the dimension of what it meets.
     """
 
-    kind: str  # 'bool' | 'num' | 'str' | 'any'
+    kind: str  # 'bool' | 'num' | 'str' | 'polygon' | 'any'
     dim: Optional[Dimension] = None
     bare: bool = False
 
@@ -50,13 +53,25 @@ class Scope:
     dynamic: bool = True  # topics, nodes, rules and for are allowed (not in constants)
     nodes: Optional[Tuple[str, ...]] = None  # the entity header, when inside an entity
     entity: str = ""
+    actions: Optional[FrozenSet[str]] = None  # declared actions, for active()
+    active_uses: Optional[Set[str]] = None  # filled with the actions active() names
+    model: Optional[FieldModel] = None  # a system model: kinds and units of topic fields
 
 
-class ExprChecker:
+@dataclass
+class _Quant:
+    """Inside any/all/count: the array its terms run over (set by the first one)."""
+
+    func: str
+    array: Optional[ast.TopicRef] = None
+
+
+class ExprChecker(BuiltinChecks):
     """Checks one expression and returns its checked form; diagnostics go to `diags`."""
 
     def __init__(self, scope: Scope, diags: List[Diagnostic]) -> None:
         self.scope, self.diags = scope, diags
+        self.quant: Optional[_Quant] = None
 
     def error(self, span: Span, msg: str) -> None:
         self.diags.append(Diagnostic(span, msg))
@@ -104,9 +119,56 @@ class ExprChecker:
     def _topicref(self, e: ast.TopicRef) -> Tuple[ast.Expr, Ty]:
         if not self.scope.dynamic:
             self.error(e.span, "a constant cannot read a topic")
-        elif not e.path:
+            return e, ANY
+        if not e.path:
             self.error(e.span, f"'topic {e.topic}' needs a field, e.g. 'topic {e.topic}.data'; "
                                "use age() or frequency() for the topic itself")
+            return e, ANY
+        if ast.slice_at(e.path) < 0:
+            return e, self._field_ty(e)
+        if self.quant is None:
+            self.error(e.span, "an array term ('[*]' or '[A:B]') can only be used inside min(), max(), len(), "
+                               "any(), all() or count()")
+            return e, ANY
+        array, elem = self._array_term(e)
+        if self.quant.array is None:
+            self.quant.array = array
+        elif self.quant.array != array:
+            self.error(e.span, f"two arrays in one {self.quant.func}(): 'topic {array.topic}{array.path_text}' and "
+                               f"'topic {self.quant.array.topic}{self.quant.array.path_text}'; every array term "
+                               "inside one quantifier must run over the same array")
+        return ast.Elem(elem, span=e.span), self._field_ty(e)
+
+    def _field_ty(self, e: ast.TopicRef, array: bool = False) -> Ty:
+        """What the system model says of a field (no model: unknown kind and dimension)."""
+        model = self.scope.model
+        info = model.field(e.topic, e.path) if model is not None else None
+        if info is None:
+            return ANY
+        where = f"'topic {e.topic}{e.path_text}'"
+        if info.kind == "missing":
+            self.error(e.span, info.why or f"{where} is not a field of its type")
+            return ANY
+        if array:
+            if info.kind != "array" and ast.slice_at(e.path) < 0:
+                self.error(e.span, f"{where} is not an array{': ' + info.why if info.why else ''}")
+                return ANY
+            kind = info.elem_kind if info.kind == "array" else info.kind
+            return Ty("num", info.dim) if kind == "num" else ANY
+        if info.kind == "array":
+            self.error(e.span, f"{where} is an array{' (' + info.why + ')' if info.why else ''}: use min(), "
+                               "max() or len() of it, an index such as [0], or any()/all()/count()")
+            return ANY
+        if info.kind == "msg":
+            self.error(e.span, f"{where} is a message, not a value{': ' + info.why if info.why else ''}; "
+                               "name one of its fields")
+            return ANY
+        if info.kind == "num":
+            return Ty("num", info.dim)
+        return {"bool": BOOL, "str": STR}.get(info.kind, ANY)
+
+    def _pair(self, e: ast.Pair) -> Tuple[ast.Expr, Ty]:
+        self.error(e.span, "a point '(x, y)' can only be a vertex of polygon()")
         return e, ANY
 
     def _noderef(self, e: ast.NodeRef) -> Tuple[ast.Expr, Ty]:
@@ -122,6 +184,9 @@ class ExprChecker:
             return _fold(out), BOOL
         self._want_num(ty, e.operand.span, "'-'")
         return _fold(replace(e, operand=operand)), ty
+
+    def _within(self, e: ast.Within) -> Tuple[ast.Expr, Ty]:
+        return self._postfix(e, "within")
 
     def _binary(self, e: ast.Binary) -> Tuple[ast.Expr, Ty]:
         left, lt = self.check(e.left)
@@ -154,20 +219,31 @@ class ExprChecker:
         return _fold(out), ty
 
     def _for(self, e: ast.For) -> Tuple[ast.Expr, Ty]:
+        return self._postfix(e, "for")
+
+    def _postfix(self, e: Union[ast.For, ast.Within], word: str) -> Tuple[ast.Expr, Ty]:
+        """`E for T` and `E within T`: E a condition, T a constant time, finite and not negative."""
         if not self.scope.dynamic:
-            self.error(e.span, "a constant cannot use 'for'")
+            self.error(e.span, f"a constant cannot use '{word}'")
         operand, ty = self.check(e.operand)
-        self._want_bool(ty, e.operand.span, "'for'")
+        self._want_bool(ty, e.operand.span, f"'{word}'")
         duration, dty = self.check(e.duration)
-        if not isinstance(duration, ast.Lit) or isinstance(duration.value, (bool, str)):
-            self.error(e.duration.span, "the duration of 'for' must be a constant time, such as '0.4 s'")
+        if not isinstance(duration, ast.Lit) or not isinstance(duration.value, float):
+            if _constant(duration) and dty.kind == "num":
+                self.error(e.duration.span, f"the duration of '{word}' is not a number (a division by zero, "
+                                            "or the square root of a negative)")
+            else:
+                self.error(e.duration.span, f"the duration of '{word}' must be a constant time, such as '0.4 s'")
         elif dty.bare:
-            self.error(e.duration.span, f"the duration of 'for' needs a unit of time: write "
+            self.error(e.duration.span, f"the duration of '{word}' needs a unit of time: write "
                                         f"'{_num_text(duration.value)} s'")
         elif dty.dim != TIME:
-            self.error(e.duration.span, f"the duration of 'for' must be a time, not a {_describe(dty)}")
-        elif duration.value < 0 or math.isnan(duration.value):
-            self.error(e.duration.span, "the duration of 'for' cannot be negative")
+            self.error(e.duration.span, f"the duration of '{word}' must be a time, not a {_describe(dty)}")
+        elif duration.value < 0:
+            self.error(e.duration.span, f"the duration of '{word}' cannot be negative")
+        elif math.isinf(duration.value):
+            self.error(e.duration.span, f"the duration of '{word}' must be finite"
+                                        + (" (a 'for' of infinity would never be true)" if word == "for" else ""))
         return replace(e, operand=operand, duration=duration), BOOL
 
     # -- functions -----------------------------------------------------------------------
@@ -175,12 +251,8 @@ class ExprChecker:
         if e.func not in FUNCTIONS:
             self.error(e.span, f"unknown function '{e.func}'{did_you_mean(e.func, FUNCTIONS)}")
             return e, ANY
-        if e.func in ("frequency", "age"):
-            return self._topic_fn(e)
-        if e.func in ("alive", "cpu", "memory"):
-            return self._node_fn(e)
-        if e.func in ("min", "max", "len") and len(e.args) == 1:
-            return self._array_fn(e)
+        if e.func not in SCALAR_FUNCTIONS or (e.func in ("min", "max") and len(e.args) == 1):
+            return self._builtin(e)
         arity = {"abs": 1, "sqrt": 1, "hypot": 2, "len": 1}.get(e.func)
         if arity is not None and len(e.args) != arity:
             self.error(e.span, f"{e.func}() takes {arity} argument{'s' if arity > 1 else ''}, "
@@ -201,54 +273,8 @@ class ExprChecker:
             result = _join(result, t)
         if e.func == "sqrt" and result.dim is not None:
             d = dim_sqrt(result.dim)
-            result = Ty("num", d, result.bare) if d is not None else num(None)
+            result = Ty("num", d if d is not None else ODD, result.bare)
         return _fold(replace(e, args=tuple(args))), result
-
-    def _array_fn(self, e: ast.Call) -> Tuple[ast.Expr, Ty]:
-        arg = e.args[0]
-        if not isinstance(arg, ast.TopicRef):
-            what = "an array field such as 'topic /scan.ranges'" if e.func == "len" else \
-                "an array field such as 'topic /scan.ranges', or at least two values"
-            self.error(arg.span, f"{e.func}() of one argument needs {what}")
-            return e, ANY
-        self._topicref(arg)
-        return e, (BARE if e.func == "len" else num(None))
-
-    def _topic_fn(self, e: ast.Call) -> Tuple[ast.Expr, Ty]:
-        args = list(e.args)
-        if not self.scope.dynamic:
-            self.error(e.span, f"a constant cannot use {e.func}()")
-        max_args = 2 if e.func == "frequency" else 1
-        if not args or len(args) > max_args or not isinstance(args[0], ast.TopicRef):
-            form = "frequency(topic /t) or frequency(topic /t, 2 s)" if e.func == "frequency" else "age(topic /t)"
-            self.error(e.span, f"{e.func}() is written {form}")
-            return e, ANY
-        if args[0].path:
-            self.error(args[0].span, f"{e.func}() takes a topic, not a field: write "
-                                     f"'{e.func}(topic {args[0].topic})'")
-        if len(args) == 2:
-            window, wty = self.check(args[1])
-            if not isinstance(window, ast.Lit) or wty.dim != TIME or wty.bare \
-                    or not isinstance(window.value, float) or window.value <= 0:
-                self.error(args[1].span, "the window of frequency() must be a positive constant time, "
-                                         "such as '2 s'")
-            args[1] = window
-        ty = num(FREQUENCY) if e.func == "frequency" else num(TIME)
-        return replace(e, args=tuple(args)), ty
-
-    def _node_fn(self, e: ast.Call) -> Tuple[ast.Expr, Ty]:
-        if not self.scope.dynamic:
-            self.error(e.span, f"a constant cannot use {e.func}()")
-        if len(e.args) != 1 or not isinstance(e.args[0], ast.NodeRef):
-            self.error(e.span, f"{e.func}() is written {e.func}(node /name)")
-            return e, ANY
-        ref = e.args[0]
-        nodes = self.scope.nodes
-        if nodes is not None and _norm(ref.node) not in {_norm(n) for n in nodes}:
-            self.error(ref.span, f"node '{ref.node}' is not in the nodes of entity '{self.scope.entity}' "
-                                 f"({', '.join(nodes) or 'none declared'}){did_you_mean(ref.node, nodes)}")
-        ty = {"alive": BOOL, "cpu": num(DIMENSIONLESS), "memory": num(MEMORY)}[e.func]
-        return e, ty
 
     # -- helpers -------------------------------------------------------------------------
     def _want_bool(self, ty: Ty, span: Span, what: str) -> None:
@@ -263,10 +289,6 @@ class ExprChecker:
         if a.kind == b.kind == "num" and a.dim is not None and b.dim is not None \
                 and not a.bare and not b.bare and a.dim != b.dim:
             self.error(span, template.format(f"a {dimension_name(a.dim)}", f"a {dimension_name(b.dim)}"))
-
-
-def _norm(name: str) -> str:
-    return name if name.startswith("/") else "/" + name
 
 
 def _join(a: Ty, b: Ty) -> Ty:
@@ -286,7 +308,7 @@ def _describe(ty: Ty) -> str:
         if ty.bare or ty.dim is None:
             return "number"
         return f"number ({dimension_name(ty.dim)})"
-    return {"bool": "condition", "str": "string", "any": "value"}[ty.kind]
+    return {"bool": "condition", "str": "string", "any": "value", "polygon": "polygon"}[ty.kind]
 
 
 def _num_text(v: float) -> str:
@@ -298,36 +320,28 @@ def _ty_of_value(v: Value) -> Ty:
         return BOOL
     if isinstance(v, str):
         return STR
+    if isinstance(v, tuple):
+        return Ty("polygon", DIMENSIONLESS, bare=True)
     return BARE
 
 
-_ARITH = {
-    "+": lambda a, b: a + b, "-": lambda a, b: a - b, "*": lambda a, b: a * b,
-    "/": lambda a, b: a / b if b else math.nan,
-    "<": lambda a, b: a < b, "<=": lambda a, b: a <= b, ">": lambda a, b: a > b,
-    ">=": lambda a, b: a >= b, "==": lambda a, b: a == b, "!=": lambda a, b: a != b,
-    "and": lambda a, b: a and b, "or": lambda a, b: a or b,
-}
-_FUNCS = {"abs": abs, "sqrt": lambda x: math.sqrt(x) if x >= 0 else math.nan,
-          "min": min, "max": max, "hypot": math.hypot}
+def _constant(e: ast.Expr) -> bool:
+    """No topic, node, rule or time in it: its value is known before the monitor starts."""
+    return all(isinstance(x, (ast.Lit, ast.Unary, ast.Binary, ast.Call, ast.Num)) for x in ast.walk(e))
 
 
 def _fold(e: ast.Expr) -> ast.Expr:
-    """Replace an operation on literals by its value, so constants cost nothing at run time."""
-    try:
-        if isinstance(e, ast.Unary) and isinstance(e.operand, ast.Lit):
-            v = e.operand.value
-            if e.op == "not" and isinstance(v, bool):
-                return ast.Lit(not v, span=e.span)
-            if e.op == "-" and isinstance(v, float):
-                return ast.Lit(-v, span=e.span)
-        if isinstance(e, ast.Binary) and isinstance(e.left, ast.Lit) and isinstance(e.right, ast.Lit):
-            a, b = e.left.value, e.right.value
-            if type(a) is type(b):
-                return ast.Lit(_ARITH[e.op](a, b), span=e.span)
-        if isinstance(e, ast.Call) and e.func in _FUNCS and e.args \
-                and all(isinstance(a, ast.Lit) and isinstance(a.value, float) for a in e.args):
-            return ast.Lit(float(_FUNCS[e.func](*[a.value for a in e.args])), span=e.span)  # type: ignore
-    except (ArithmeticError, ValueError, TypeError):
-        pass
-    return e
+    """Replace an operation on literals by its value, with the engine's own operator table, so
+    constants cost nothing at run time and mean the same. An operation whose value is unknown
+    (a division by zero, sqrt of a negative) stays unfolded: the engine finds it unknown too."""
+    value: Any = UNKNOWN
+    if isinstance(e, ast.Unary) and isinstance(e.operand, ast.Lit):
+        value = UNARY[e.op](e.operand.value)
+    elif isinstance(e, ast.Binary) and isinstance(e.left, ast.Lit) and isinstance(e.right, ast.Lit):
+        value = BINARY[e.op](e.left.value, e.right.value)
+    elif isinstance(e, ast.Call) and e.func in SCALAR_FUNCTIONS and e.args \
+            and all(isinstance(a, ast.Lit) for a in e.args):
+        value = scalar_fn(e.func)(*[a.value for a in e.args])  # type: ignore[union-attr]
+    if value is UNKNOWN:
+        return e
+    return ast.Lit(value, span=e.span)

@@ -35,6 +35,8 @@ LENGTH = dim(m=1)
 SPEED = dim(m=1, s=-1)
 FREQUENCY = dim(s=-1)
 MEMORY = dim(B=1)
+# the dimension of sqrt of an odd power (sqrt(1 m), sqrt(age(…))): no SI dimension matches it
+ODD: Dimension = (("sqrt of an odd power", 1),)
 VOLTAGE = dim(V=1)
 CURRENT = dim(A=1)
 TEMPERATURE = dim(degC=1)  # Celsius only: no kelvin, so no offset to convert

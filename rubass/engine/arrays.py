@@ -1,0 +1,101 @@
+"""Arrays (LANGUAGE.md §12): min/max/len over an array term, and the any/all/count quantifiers.
+
+The store holds an array term's elements as the message gave them (a tuple, bytes for uint8[]);
+the element path is read here, per evaluation, only for the terms the spec names.
+"""
+from __future__ import annotations
+
+import math
+from typing import Any, Callable, List, Optional, Tuple
+
+from ..lang.ast import PathElem
+from .fields import FieldError, convert, extract
+from .values import UNKNOWN, as_bool, k_and, k_or
+
+Fn = Callable[[], Any]
+
+
+def element(item: Any, path: Tuple[PathElem, ...]) -> Any:
+    """One element's value at `path` (UNKNOWN when it cannot be read as a value)."""
+    try:
+        return extract(item, path) if path else convert(item)
+    except FieldError:
+        return UNKNOWN
+
+
+def _numbers(arr: Any, path: Tuple[PathElem, ...]) -> Optional[List[float]]:
+    """The array's numeric values (per element `path`), NaN and non-numbers skipped (REP 117)."""
+    if path:
+        vals = [element(item, path) for item in arr]
+        return [v for v in vals if type(v) is float and v == v]
+    if isinstance(arr, bytes):
+        return [float(b) for b in arr]
+    return [float(v) for v in arr if (type(v) is float or type(v) is int) and v == v]
+
+
+def array_fn(name: str, read: Fn, path: Tuple[PathElem, ...], limits: Optional[Fn] = None) -> Fn:
+    """min/max/len of an array term; `limits` gives a LaserScan's (range_min, range_max) (§12)."""
+    def apply() -> Any:
+        arr = read()
+        if not isinstance(arr, (tuple, bytes)):
+            return UNKNOWN
+        if name == "len":
+            return float(len(arr))
+        pick = min if name == "min" else max
+        if limits is not None:
+            lim = limits()
+            if lim is not None:
+                return _laser(pick, arr, lim)
+        if not path and arr and type(arr[0]) is float:  # a typed float array: C speed when no NaN
+            try:
+                total = sum(arr)
+            except TypeError:
+                total = math.nan
+            if total == total:
+                return float(pick(arr))
+        valid = _numbers(arr, path)
+        return float(pick(valid)) if valid else UNKNOWN
+    return apply
+
+
+def _laser(pick: Callable[..., float], ranges: Any, lim: Tuple[float, float]) -> Any:
+    """REP 117: NaN, +inf and finite readings outside [range_min, range_max] are no reading;
+    -inf (too close to measure) is 0 m; unknown when no reading is left."""
+    lo, hi = lim
+    if not isinstance(ranges, tuple):
+        return UNKNOWN
+    if ranges:
+        total = sum(ranges)  # NaN when a reading is NaN: then min/max are not reliable
+        m, n = min(ranges), max(ranges)  # C speed; exact when every reading is within the limits
+        if total == total and lo <= m and n <= hi:
+            return float(pick(m, n))
+    valid = [v for v in ranges if lo <= v <= hi]
+    if -math.inf in ranges:
+        valid.append(0.0)
+    return float(pick(valid)) if valid else UNKNOWN
+
+
+def quantifier(name: str, read: Fn, cell: List[Any], body: Fn) -> Fn:
+    """any/all/count(body) with cell[0] set to each element in turn (Kleene or / and / count)."""
+    def apply() -> Any:
+        arr = read()
+        if not isinstance(arr, (tuple, bytes)):
+            return UNKNOWN
+        if name == "count":
+            n = 0.0
+            for item in arr:
+                cell[0] = item
+                v = as_bool(body())
+                if v is UNKNOWN:
+                    return UNKNOWN
+                n += v is True
+            return n
+        acc: Any = name == "all"
+        join = k_and if name == "all" else k_or
+        for item in arr:
+            cell[0] = item
+            acc = join(acc, as_bool(body()))
+            if acc is (name == "any"):  # decided: one true for any, one false for all
+                return acc
+        return acc
+    return apply

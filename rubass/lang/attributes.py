@@ -1,0 +1,61 @@
+"""Traceability attributes (LANGUAGE.md §15): which are known, their arguments, unique ids, and
+what a rule inherits from its entity."""
+from __future__ import annotations
+
+from typing import Dict, List, Sequence, Tuple
+
+from . import ast
+from .errors import Diagnostic, did_you_mean
+from .model import Attrs
+from .source import Span
+
+# name -> (least, most) number of string arguments; most None: no limit
+KNOWN: Dict[str, Tuple[int, object]] = {"id": (1, 1), "hazard": (1, None), "title": (1, 1), "ref": (1, None)}
+NOT_INHERITED = frozenset({"id"})  # an entity's id names the entity, not each of its rules
+
+
+class AttrChecker:
+    """Checks attributes where they stand and keeps the ids seen, to report duplicates."""
+
+    def __init__(self, diags: List[Diagnostic]) -> None:
+        self.diags = diags
+        self.ids: Dict[str, Span] = {}
+
+    def own(self, attrs: Sequence[ast.Attr], what: str) -> Attrs:
+        """The attributes written on one entity, rule or behaviour, checked."""
+        out: Attrs = {}
+        for a in attrs:
+            if a.name not in KNOWN:
+                self.diags.append(Diagnostic(a.span, f"unknown attribute '@{a.name}' on a {what}; known: "
+                                                     f"@id, @hazard, @title, @ref{did_you_mean(a.name, KNOWN)}"))
+                continue
+            least, most = KNOWN[a.name]
+            if len(a.args) < least or (most is not None and len(a.args) > most):
+                want = "one string" if most == 1 else "one or more strings"
+                self.diags.append(Diagnostic(a.span, f"@{a.name} takes {want}, got {len(a.args)}"))
+                continue
+            if a.name in out:
+                self.diags.append(Diagnostic(a.span, f"@{a.name} is given twice on this {what}: write all its "
+                                                     f"values in one, e.g. @{a.name}(\"A\", \"B\")"
+                                             if most is None else f"@{a.name} is given twice on this {what}"))
+                continue
+            if a.name == "id":
+                first = self.ids.get(a.args[0])
+                if first is not None:
+                    self.diags.append(Diagnostic(a.span, f"duplicate id \"{a.args[0]}\"; first given at {first}"))
+                    continue
+                self.ids[a.args[0]] = a.span
+            out[a.name] = tuple(a.args)
+        return out
+
+    def check_rules(self, entities: Dict[str, ast.Entity]) -> None:
+        """Check every entity's and rule's own attributes (ids included), once."""
+        self._entity_attrs = {name: self.own(ent.attrs, "entity") for name, ent in entities.items()}
+        self._rule_attrs = {(name, r.name.name): self.own(r.attrs, "rule")
+                            for name, ent in entities.items() for r in ent.rules}
+
+    def rule_attrs(self, entity: ast.Entity, rule: ast.Rule) -> Attrs:
+        """A rule's attributes: its own, and for each attribute it lacks, its entity's (not the id)."""
+        inherited = {k: v for k, v in self._entity_attrs.get(entity.name.name, {}).items() if k not in NOT_INHERITED}
+        inherited.update(self._rule_attrs.get((entity.name.name, rule.name.name), {}))
+        return inherited
