@@ -6,6 +6,7 @@ in benchmarks, a manual one in tests), and events are handed to a callback.
 """
 from __future__ import annotations
 
+import dataclasses
 import queue
 import threading
 from dataclasses import dataclass
@@ -14,6 +15,7 @@ from typing import Any, Callable, Dict, List, Optional, Tuple
 from .engine import Engine, Event
 
 Handler = Callable[[List[Event], Any], None]  # (events, cause: the input item, or None for a wake-up)
+JumpHook = Callable[[Engine, float], Tuple[Engine, List[Event]]]  # (old engine, now) -> new engine, its events
 
 
 @dataclass(frozen=True)
@@ -47,7 +49,7 @@ class EngineLoop:
 
     def __init__(self, engine: Engine, clock: Callable[[], float], rate: float, handler: Handler,
                  max_queue: int = 100000, tick_hook: Optional[Callable[[float], None]] = None,
-                 max_bytes: int = 256 * 1024 * 1024) -> None:
+                 max_bytes: int = 256 * 1024 * 1024, on_clock_jump: Optional[JumpHook] = None) -> None:
         self.engine = engine
         self.clock = clock
         self.period = 1.0 / rate
@@ -66,6 +68,12 @@ class EngineLoop:
         self._bytes_lock = threading.Lock()
         self._stop = threading.Event()
         self._next_tick = clock() + self.period
+        # The clock jumping back (sim time reset, the wall clock stepped back) by more than this
+        # restarts the engine's windows: its times belong to the old timeline (see on_clock_jump).
+        self.on_clock_jump = on_clock_jump
+        self.jump_tolerance = max(0.25, 2 * self.period)
+        self._last_clock = clock()
+        self.clock_jumps = 0
 
     # -- any thread ----------------------------------------------------------------------
     def submit(self, item: Any) -> bool:
@@ -125,6 +133,9 @@ class EngineLoop:
     def step(self, max_wait: Optional[float] = None) -> None:
         """Wait for an input or the next wake-up, then handle everything that is due."""
         now = self.clock()
+        if now < self._last_clock - self.jump_tolerance:
+            self._clock_jumped(now)
+        self._last_clock = now
         if self._next_tick > now + 2 * self.period:  # the clock jumped back (sim time restarted, NTP)
             self._next_tick = now + self.period
         wake = self._next_tick
@@ -156,6 +167,18 @@ class EngineLoop:
             if self._next_tick <= now:  # ticks were missed (a stall): go on from now, no burst
                 self._next_tick = now + self.period
 
+    def _clock_jumped(self, now: float) -> None:
+        """Time went back: a new engine at `now` (the hook carries what must stay active)."""
+        self.clock_jumps += 1
+        self._next_tick = now + self.period
+        self._applied.clear()
+        if self.on_clock_jump is not None:
+            self.engine, events = self.on_clock_jump(self.engine, now)
+        else:
+            self.engine = Engine(self.engine.spec, now)
+            events = self.engine.evaluate_all(now)
+        self._emit(events, "clock")
+
     def _handle_newest(self) -> None:
         """The newest message of each topic that overflowed, in time order, before older queued ones."""
         with self._bytes_lock:
@@ -165,6 +188,9 @@ class EngineLoop:
             self._emit(self.engine.on_message(m.topic, m.time, m.msg), m)
 
     def _handle(self, item: Any) -> None:
+        if self.clock_jumps and isinstance(item, (Message, NodeSample)) and \
+                item.time > self._last_clock + self.jump_tolerance:
+            item = dataclasses.replace(item, time=self.clock())  # stamped on the old timeline, before the jump
         if isinstance(item, Message):
             self._unqueue(item.size)
             if self._applied and item.time <= self._applied.get(item.topic, float("-inf")):

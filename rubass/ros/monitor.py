@@ -58,6 +58,7 @@ from .master_watch import MasterWatch
 from .nodes import NodeSampler
 from .outputs import Outputs
 from .overload import OverloadGuard
+from .clockjump import ClockJump
 from .keeper import LatchKeeper
 from .latches import LatchFile, default_path
 from .params import MonitorConfig, ParamError, read_config
@@ -141,6 +142,8 @@ class Monitor:
         self.dispatcher = Dispatcher({}, self.outputs.event, _ros_now)
         self.overload = OverloadGuard(self.config.overload_actions, 1.0, _log, self.outputs.event)
         self.keeper = LatchKeeper(LatchFile(self.config.state_file, self.config.spec), _log, self.outputs.event)
+        self.clock_jump = ClockJump(self.dispatcher, _log,
+                                    lambda engine: self.keeper.save(engine, self.dispatcher.orphans, self._fail_safes()))
         try:
             spec, runners = self.load()
         except ConfigError:
@@ -189,7 +192,7 @@ class Monitor:
         now = self._first_time()
         engine = Engine(spec, now)
         self.loop = EngineLoop(engine, _ros_now, self.config.rate, self._on_events,
-                               max_queue=self.config.queue_size, tick_hook=self._tick)
+                               max_queue=self.config.queue_size, tick_hook=self._tick, on_clock_jump=self.clock_jump)
         self._on_events(engine.evaluate_all(now), "reload")
         self.keeper.save(engine, self.dispatcher.orphans, self._fail_safes())
         self.watcher = TopicWatcher(self._on_message, _log)
@@ -228,6 +231,7 @@ class Monitor:
                             loop.dropped_by_topic)
         if was and not self.overload.active:
             self.keeper.save(loop.engine, self.dispatcher.orphans, self._fail_safes())
+        self.clock_jump.check(loop.engine, now)
 
     def _sampler(self, spec: CheckedSpec) -> NodeSampler:
         nodes = [(n, rospy.resolve_name(n)) for n in sorted(spec.nodes)]
@@ -422,6 +426,7 @@ class Monitor:
             if r.stats.last_error:
                 monitor[f"action {name}"] = r.stats.last_error
         monitor.update(self.keeper.status())
+        monitor["clock jumps back"] = loop.clock_jumps
         assert self.spec is not None
         entries = status_mod.build(self.spec, rules, active, topics, nodes, field_errors, monitor)
         self.outputs.status(entries, _ros_now())

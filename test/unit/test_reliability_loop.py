@@ -64,3 +64,79 @@ def test_the_newest_of_each_topic_is_kept_and_other_topics_are_untouched():
     loop.submit(Message("/y", clock.t, {"data": 0.0}))
     drain(loop, clock, 5)
     assert loop.engine.rule_value("a.q") is False
+
+
+def test_a_clock_that_jumps_back_restarts_windows_and_a_persisting_violation_is_still_stopped():
+    loop, clock, got = make("entity a { rules: r: (topic /x.data > 1) for 1 s; }\nif (a.r) then { stop; }\n")
+    for _ in range(5):  # 0.5 s of the violation at 100 s
+        clock.t += 0.1
+        loop.submit(Message("/x", clock.t, {"data": 5.0}))
+        loop.step(max_wait=0)
+    clock.t = 10.0  # the simulator is reset
+    jump = clock.t
+    for _ in range(15):
+        clock.t += 0.1
+        loop.submit(Message("/x", clock.t, {"data": 5.0}))
+        loop.step(max_wait=0)
+        loop.step(max_wait=0)
+    starts = [e for e in got if e.kind == "start"]
+    assert loop.clock_jumps == 1
+    assert starts and jump < starts[0].time <= jump + 1.1 + 1e-9, starts  # not at 101 s of the old timeline
+
+
+def test_clock_jump_hook_holds_what_was_active_until_the_rebuilt_engine_takes_it_over():
+    from rubass.ros.clockjump import ClockJump, horizon
+
+    loop, clock, got = make("entity a { rules: r: (topic /x.data > 1) for 1 s; }\nif (a.r) then { warn; }\n")
+    released = []
+
+    class Dispatcher:
+        def __init__(self):
+            self.orphans = []
+
+        def keys_of(self, spec):
+            return {b.index: ("k", b.index) for b in spec.behaviours}
+
+        def release(self, b, key, now):
+            released.append((b.index, now))
+
+    assert horizon(loop.engine.spec) == 1.5
+    hook = ClockJump(Dispatcher(), lambda level, text: None, lambda engine: None)
+    loop.on_clock_jump = hook
+    for _ in range(12):
+        clock.t += 0.1
+        loop.submit(Message("/x", clock.t, {"data": 5.0}))
+        loop.step(max_wait=0)
+    assert loop.engine.active_behaviours() == [1]
+    clock.t = 10.0
+    loop.submit(Message("/x", clock.t, {"data": 0.0}))  # the violation is gone after the reset
+    loop.step(max_wait=0)
+    assert len(hook.carried) == 1 and not released
+    clock.t = 11.0
+    hook.check(loop.engine, clock.t)
+    assert not released, "held while a persisting violation could still be re-established"
+    clock.t = 11.6
+    hook.check(loop.engine, clock.t)
+    assert released == [(1, 11.6)] and not hook.carried
+
+
+def test_after_a_clock_jump_a_latched_behaviour_is_held_until_reset_like_after_a_reload():
+    from rubass.ros.clockjump import ClockJump
+
+    loop, clock, got = make("entity a { rules: r: topic /x.data > 1; }\nif (a.r) then { stop; }\n")
+
+    class Dispatcher:
+        def __init__(self):
+            self.orphans = []
+
+        def keys_of(self, spec):
+            return {b.index: ("k", b.index) for b in spec.behaviours}
+
+    d = Dispatcher()
+    loop.on_clock_jump = ClockJump(d, lambda level, text: None, lambda engine: None)
+    clock.t += 0.1
+    loop.submit(Message("/x", clock.t, {"data": 5.0}))
+    loop.step(max_wait=0)
+    clock.t = 10.0
+    loop.step(max_wait=0)
+    assert [(b.index, key) for b, key in d.orphans] == [(1, ("k", 1))]
