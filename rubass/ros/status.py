@@ -11,6 +11,8 @@ from ..lang import ast
 from ..lang.model import CheckedSpec
 
 OK, WARN, ERROR = 0, 1, 2  # DiagnosticStatus levels
+# node references: NodeRef (version 1), NodeStat (alive/cpu/memory in version 2 of the language)
+_NODE_REFS = tuple(getattr(ast, n) for n in ("NodeRef", "NodeStat") if hasattr(ast, n))
 
 
 @dataclass
@@ -39,7 +41,7 @@ def unknown_reasons(spec: CheckedSpec, rule_key: str, topics: Dict[str, Dict[str
             fe = field_errors.get((e.topic, str(e.path)))
             if fe:
                 why.append(f"{e.topic}: {fe}")
-        elif isinstance(e, ast.NodeRef):
+        elif isinstance(e, _NODE_REFS):
             n = nodes.get(e.node)
             if n is not None and n.get("why") not in (None, "alive"):
                 why.append(f"node {e.node}: {n['why']}")

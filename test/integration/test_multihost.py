@@ -173,11 +173,39 @@ def test_a_cpu_hog_on_another_host_is_measured_by_its_agent_and_stopped(cluster,
     spec = write_spec(tmp_path, "entity arm: hog { rules: busy: (cpu(node hog) > 30 %) for 1 s; }\n"
                                 "if (arm.busy) then { stop; }\n")
     stops = cluster.listen("arm", "arm_listener", "/safety_cmd:geometry_msgs/Twist")
+    bag = tmp_path / "run.bag"  # the agents' reports only: replay must use them
+    recorder = cluster.spawn("safety", ["rosbag", "record", "-O", str(bag), "/rubass/agent_samples"], "record")
     watch = start_everywhere(cluster, spec, ("arm", "hog", "hog"))
     wait_for(cluster, "the stop reached the arm's host", lambda: lines(stops), timeout=40)
     start = wait_for(cluster, "a start event", lambda: [e for e in events(watch) if e["event"] == "start"])[0]
     assert start["rules"] == ["arm.busy"] and start["actions"] == ["stop"]
     assert start["cause"] in ("deadline", "node sample of hog")
+    time.sleep(0.5)
+    os.killpg(recorder.pid, signal.SIGINT)  # rosbag and its recorder child write a complete bag on SIGINT
+    assert recorder.wait(20) == 0, cluster.log(recorder)
+    out = subprocess.run([PY, "-m", "rubass", "replay", spec, str(bag), "--json"], cwd=ROOT, capture_output=True,
+                         text=True, timeout=120, env=dict(os.environ, PYTHONPATH=ROOT))
+    assert out.returncode == 0, out.stderr
+    replayed = [json.loads(line) for line in out.stdout.splitlines()]
+    assert [x["actions"] for x in replayed if x["event"] == "start"] == [["stop"]], out.stdout + out.stderr
+
+
+def test_agent_launch_reports_the_nodes_of_its_host(ros, tmp_path):
+    """launch/agent.launch included from a host's bringup; no namespaces needed."""
+    bringup = tmp_path / "bringup.launch"
+    bringup.write_text('<launch>\n  <include file="$(find rubass)/launch/agent.launch">\n'
+                       '    <arg name="node_rate" value="5"/>\n  </include>\n</launch>\n')
+    ros.env["ROS_PACKAGE_PATH"] = ROOT + os.pathsep + ros.env.get("ROS_PACKAGE_PATH", "/usr/share")
+    launch = ros.spawn(["roslaunch", "--wait", str(bringup)], "roslaunch")
+    rec = ros.probe({"listen": [{"topic": "/rubass/agent_samples", "type": "std_msgs/String"}],
+                     "steps": [{"wait": "/rubass/agent_samples", "timeout": 30}, {"sleep": 0.5}]})
+    reports = [json.loads(r["msg"]["data"]) for r in rec if r["kind"] == "recv"]
+    assert reports, ros.log(launch)
+    last = reports[-1]
+    assert last["agent"].startswith("/rubass_agent") and last["period"] == pytest.approx(0.2)
+    assert last["agent"] in {n["node"] for n in last["nodes"]}  # it reports itself, a node of this host
+    launch.send_signal(signal.SIGINT)
+    assert launch.wait(20) == 0
 
 
 def test_a_killed_agent_makes_its_hosts_rules_unknown_and_the_status_names_it(cluster, tmp_path):
@@ -206,9 +234,11 @@ def test_a_cut_link_fires_the_age_and_alive_rules_as_written(cluster, tmp_path):
                                 "  gone: not alive(node driver); }\n"
                                 "if (base.stale) then { warn(\"odometry stale\"); }\n"
                                 "if (base.gone) then { warn(\"driver gone\"); }\n")
+    beats = cluster.listen("robot", "board", "/rubass/heartbeat:std_msgs/Header")  # where a watchdog would be
     watch = start_everywhere(cluster, spec, ("robot", "driver", "talk", "/odom", "20"))
     wait_for(cluster, "the base's rules false",
              lambda: [s for s in statuses(watch, "rubass: base") if s[1] == "all rules false"], timeout=40)
+    wait_for(cluster, "heartbeats on the robot's host", lambda: lines(beats))
     cluster.net.cut("robot")
     cut = time.time()
     started = wait_for(cluster, "both behaviours started",
@@ -219,3 +249,5 @@ def test_a_cut_link_fires_the_age_and_alive_rules_as_written(cluster, tmp_path):
     # age > 1 s fires no sooner than a second after the last message came, i.e. after the cut
     assert first[1]["wall"] - cut > 0.9
     assert first[2]["wall"] - cut < 10
+    # a watchdog on the robot's host hears no heartbeat after the cut (TCP may deliver what was in flight)
+    assert all(b["wall"] < cut + 0.5 for b in lines(beats))

@@ -111,3 +111,18 @@ def test_replay_leaves_nodes_the_monitor_sampled_and_unknown_names_alone():
 def test_replay_skips_a_broken_report():
     stream = [(1.0, "/rubass/agent_samples", Msg("{")), (1.1, "/cmd", "m")]
     assert list(agent_samples(stream, {"/rubass/agent_samples"}, {}, set(), end=2.0)) == [(1.1, "/cmd", "m")]
+
+
+def test_diagnostics_warn_while_an_agent_is_silent_and_say_why_the_rule_is_unknown():
+    from rubass.lang import check_text
+    from rubass.ros import status
+
+    spec = check_text("entity arm: hog { rules: busy: cpu(node hog) > 50 %; }\n")
+    why = "agent /rubass_agent_b on host 10.200.1.2 is silent: its last report came 0.5 s ago"
+    entries = status.build(spec, {"arm.busy": UNKNOWN}, [], {}, {"hog": {"why": why}}, {},
+                           {"master": "connected", "silent agents": "/rubass_agent_b on 10.200.1.2 for 0.5 s"})
+    arm, mon = entries
+    assert dict(arm.values)["busy unknown because"] == f"node hog: {why}"
+    assert mon.level == status.WARN and "agent silent: /rubass_agent_b on 10.200.1.2 for 0.5 s" in mon.message
+    ok = status.build(spec, {"arm.busy": False}, [], {}, {}, {}, {"master": "connected", "silent agents": "none"})
+    assert ok[-1].level == status.OK and "agent" not in ok[-1].message
