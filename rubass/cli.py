@@ -11,7 +11,8 @@ from .replay.command import register as register_replay
 from .testing.command import register as register_test
 from .report.command import register as register_report
 from .ros.sim.command import register as register_experiments
-from .ros.model_command import add_source_options, after_check, build_model
+from .ros.model_command import add_source_options, build_model
+from .ros.libtypes import after_check, after_failed_check
 from .ros.model_command import register as register_model
 from .lang.errors import Diagnostic
 from .lang.source import SourceSet
@@ -33,7 +34,9 @@ def cmd_check(args: argparse.Namespace) -> int:
             checked = load_spec(path, args.actions, model=model)
         except SpecError as exc:
             print(exc.render(), file=sys.stderr)
-            n = sum(d.severity == "error" for d in exc.diagnostics)
+            lib_errors, warnings, lib_sources = after_failed_check(path, args.actions, model)
+            _print_diags(warnings + lib_errors, lib_sources)
+            n = sum(d.severity == "error" for d in exc.diagnostics) + len(lib_errors)
             print(f"{path}: {n} error{'s' if n != 1 else ''}", file=sys.stderr)
             status = 1
             continue

@@ -124,7 +124,7 @@ def _primitive_problem(ftype: str, v: Any) -> Optional[str]:
         return None if isinstance(v, int) and not isinstance(v, bool) else \
             "give {secs: S, nsecs: N} or a whole number of nanoseconds"
     if ftype == "bool":
-        return None if isinstance(v, bool) else "give true or false"
+        return None if isinstance(v, bool) or v in (0, 1) and isinstance(v, int) else "give true or false"
     if ftype == "string":
         return None if isinstance(v, str) else "give a string (quote it)"
     if ftype in _FLOATS:

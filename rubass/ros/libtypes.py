@@ -3,9 +3,16 @@ system after its own: action libraries against definitions, topics and nodes a m
 Light: the monitor runs these at start and at every reload."""
 from __future__ import annotations
 
-from typing import Iterable, List, Optional, Tuple
+import os
+from typing import Dict, Iterable, List, Optional, Sequence, Tuple
 
-from ..lang.errors import Diagnostic
+from ..lang import ast
+from ..lang.errors import Diagnostic, SpecError
+from ..lang.grammar import parse_source
+from ..lang.library import ActionDef, load_library
+from ..lang.paths import PathError, resolve
+from ..lang.source import SourceSet
+from ..lang.sourcefile import read_source
 from ..lang.libcheck import check_library_types, check_publish_topics, library_types
 from ..lang.model import CheckedSpec
 from ..lang.msgdef import Registry, parse_full
@@ -54,17 +61,50 @@ def after_check(checked: CheckedSpec, model: Optional[SystemModel]) -> Tuple[Lis
     """(errors, warnings) of the checks against the system: the spec's topics and nodes the
     model lacks (warnings), and its action libraries against message definitions (errors)."""
     warnings = graph_warnings(checked.spec, model) if model is not None else []
+    return library_errors(checked.actions, checked.sources, model), warnings
+
+
+def library_errors(actions: Dict[str, ActionDef], sources: SourceSet, model: Optional[SystemModel]) -> List[Diagnostic]:
+    """Publish and service actions against the model's definitions and the installed ones."""
     registry = Registry()
     if model is not None:
         for spec in model.registry.types.values():
             registry.add(spec)
-    msgs, srvs = library_types(checked.actions)
+    msgs, srvs = library_types(actions)
     installed = try_installed(registry, msgs, srvs)
     if not installed and model is None:
-        return [], warnings  # nothing to check against
+        return []  # nothing to check against
     where = " or ".join(([model.source] if model is not None else []) +
                         (["the message packages installed here"] if installed else []))
-    errors = check_library_types(checked.actions, checked.sources, registry, where)
+    errors = check_library_types(actions, sources, registry, where)
     if model is not None:
-        errors += check_publish_topics(checked.actions, checked.sources, model.topics, model.source)
-    return errors, warnings
+        errors += check_publish_topics(actions, sources, model.topics, model.source)
+    return errors
+
+
+def after_failed_check(path: str, extra: Sequence[str],
+                       model: Optional[SystemModel]) -> Tuple[List[Diagnostic], List[Diagnostic], SourceSet]:
+    """after_check for a spec that did not check, so that everything is reported in one run:
+    (library errors, topic and node warnings, their sources); nothing when the spec cannot be
+    parsed, and no library errors when a library has errors of its own (already reported)."""
+    sources = SourceSet()
+    src, _ = read_source(path)
+    if src is None:
+        return [], [], sources
+    sources.add(src)
+    try:
+        spec = parse_source(src)
+        base = os.path.dirname(os.path.abspath(path))
+        files = [resolve(d.path, base) for d in spec.decls if isinstance(d, ast.Import)] + list(extra)
+    except (SpecError, PathError):
+        return [], [], sources
+    warnings = graph_warnings(spec, model) if model is not None else []
+    actions: Dict[str, ActionDef] = {}
+    for f in files:
+        if not os.path.isfile(f):
+            continue
+        lib, diags = load_library(f, sources)
+        if diags:
+            return [], warnings, sources
+        actions.update(lib)
+    return library_errors(actions, sources, model), warnings, sources

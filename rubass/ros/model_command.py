@@ -12,7 +12,7 @@ from ..lang.modelfile import dump_model, load_model
 from ..lang.source import SourceSet
 from ..lang.sysmodel import SystemModel
 from .bag import BagError
-from .libtypes import after_check, try_installed
+from .libtypes import try_installed
 from .model_sources import LiveError, bag_model, live_model
 
 

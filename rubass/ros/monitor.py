@@ -55,6 +55,7 @@ from .agentbook import decode as decode_agent_report
 from .actions.runner import ActionRunner
 from .dispatch import Dispatcher
 from .master_watch import MasterWatch
+from .libtypes import after_check
 from .nodes import NodeSampler
 from .outputs import Outputs
 from .overload import OverloadGuard
@@ -106,6 +107,7 @@ class Monitor:
         except SpecError as exc:
             raise StartupError(exc.render()) from None
         self._check_overload_actions(spec)
+        self._check_library_types(spec)
         for w in spec.warnings:
             rospy.logwarn("rubass: %s", w.render(spec.sources))
         return spec, self._runners(spec, {})
@@ -115,6 +117,13 @@ class Monitor:
         if missing:
             raise ConfigError(f"{spec.path}: ~overload_actions names {', '.join(missing)}, which the spec does not "
                                f"declare (add 'action primitive {', '.join(missing)};')")
+
+    @staticmethod
+    def _check_library_types(spec: CheckedSpec) -> None:
+        """Publish and service actions against the installed definitions, errors at their YAML line."""
+        errors, _ = after_check(spec, None)
+        if errors:
+            raise StartupError("\n".join(d.render(spec.sources) for d in errors))
 
     def _runners(self, spec: CheckedSpec, keep: Dict[str, ActionRunner]) -> Dict[str, ActionRunner]:
         """Runners for the spec's actions, reusing those whose definition did not change."""
@@ -295,6 +304,7 @@ class Monitor:
             try:
                 spec = self._load_stable()
                 self._check_overload_actions(spec)
+                self._check_library_types(spec)
                 t_check = time.monotonic()
                 if self.spec is None:  # not enforcing yet: this spec is the first usable one
                     self._enforce(spec, self._runners(spec, {}))

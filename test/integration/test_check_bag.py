@@ -100,3 +100,43 @@ def test_library_types_checked_by_plain_check(write):
     assert "message: {linear: {x: 0, q: 1}}" in err  # the YAML line, with a caret
     assert f"{lib}:7:79: error: action 'brake': std_srvs/TriggerRequest has no field 'now'" in err
     assert f"{path}: 2 errors" in err
+
+
+def test_check_bag_field_errors_at_the_spec_line(write):
+    bag = shared_path("data", "turtlebot3_sim.bag")
+    path = spec(write, "    r: topic /cmd_vel.linear.x > 3 s;\n"
+                       "    typo: topic /odom.twist.linear.x > 1 m/s;\n"
+                       "    arr: topic /scan.ranges > 1 m;\n"
+                       "    name: topic /odom.header.frame_id > 2;\n"
+                       "    msg: topic /odom.pose.pose > 2;\n"
+                       "    ok: topic /cmd_vel.linear.x > 0.5 and min(topic /scan.ranges) < 30 cm;\n")
+    code, _, err = rubass("check", "--bag", bag, path)
+    assert code == 1
+    assert f"{path}:5:32: error: compares a speed with a time" in err
+    assert f"{path}:6:11: error: 'twist' (geometry_msgs/TwistWithCovariance) has no field 'linear'; " \
+           "did you mean 'twist.twist.linear'?" in err
+    assert f"{path}:7:10: error: 'topic /scan.ranges' is an array (float32[])" in err
+    assert f"{path}:8:11: error: '>' needs a number, not a string" in err
+    assert f"{path}:9:10: error: 'topic /odom.pose.pose' is a message, not a value: it is a geometry_msgs/Pose" in err
+    assert "        typo: topic /odom.twist.linear.x > 1 m/s;\n              ^" in err  # the line and a caret
+    assert f"{path}: 5 errors" in err  # line 10 is right: a bare 0.5 adopts m/s, 30 cm fits ranges
+
+
+def test_the_same_spec_without_a_model_is_accepted(write):
+    path = spec(write, "    r: topic /cmd_vel.linear.x > 3 s;\n    typo: topic /odom.twist.linear.x > 1 m/s;\n")
+    code, out, err = rubass("check", path)
+    assert code == 0 and "ok (" in out, err
+
+
+def test_model_file_units_of_custom_fields(write, tmp_path):
+    model = write("robot.yaml", "topics:\n  /bms: {type: acme_msgs/Pack, units: {pack_voltage: V}}\n"
+                                "definitions:\n  acme_msgs/Pack: |\n    float32 pack_voltage\n    float32 temp\n"
+                                "units:\n  acme_msgs/Pack: {temp: degC}\n")
+    good = spec(write, "    r: topic /bms.pack_voltage < 22 V or topic /bms.temp > 60 degC;\n", "good.rbs")
+    code, out, err = rubass("check", "--model", model, good)
+    assert code == 0 and "warning" not in err, err
+    bad = spec(write, "    r: topic /bms.pack_voltage < 22 A or topic /bms.temp > 60 s;\n", "bad.rbs")
+    code, _, err = rubass("check", "--model", model, bad)
+    assert code == 1
+    assert f"{bad}:5:32: error: compares a voltage with a current" in err
+    assert f"{bad}:5:58: error: compares a temperature with a time" in err

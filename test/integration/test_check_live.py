@@ -119,3 +119,26 @@ def test_no_master_is_a_clear_error(ros, write):
                           "entity e { rules: r: topic /x.data > 1; }\nif (e.r) then { stop; }\n")
     code, _, err = rubass(ros, "check", "--live", "--master", "http://127.0.0.1:9", path)
     assert code == 2 and "no ROS master at http://127.0.0.1:9" in err and "Traceback" not in err
+
+
+def test_monitor_refuses_a_library_field_its_type_lacks_at_start_and_at_reload(ros, tmp_path):
+    from rosharness import LIB as GOOD_LIB
+    from rosharness import spec as write_spec
+    from rosharness import wait_log
+
+    bad = GOOD_LIB.replace("message: {data: true}", "message: {dat: true}")
+    assert bad != GOOD_LIB
+    body = "entity a { rules: r: topic /x.data > 1; }\nif (a.r) then { brake; }\n"
+    path = write_spec(tmp_path, body, lib=bad)
+    mon = ros.monitor(path)  # up (its services answer), but not enforcing
+    wait_log(mon, ros, "std_msgs/Bool has no field 'dat'; did you mean 'data'?")
+    assert f"{tmp_path / 'lib.yaml'}:" in ros.log(mon)
+    write_spec(tmp_path, body)
+    time.sleep(0.1)
+    out = ros.call("/rubass/reload")
+    assert "True" in out.stdout, out.stdout
+    (tmp_path / "lib.yaml").write_text(bad)
+    time.sleep(0.1)
+    out = ros.call("/rubass/reload")
+    assert "False" in out.stdout and "has no field 'dat'" in out.stdout, out.stdout
+    assert mon.poll() is None
