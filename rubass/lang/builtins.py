@@ -4,12 +4,11 @@ from __future__ import annotations
 
 import math
 from dataclasses import replace
-from typing import Any, List, Optional, Tuple
+from typing import Any, List, Tuple
 
 from . import ast
 from .geometry import polygon_problem
 from .units import DIMENSIONLESS, FREQUENCY, LENGTH, MEMORY, TIME, dim_mul
-from .values import UNKNOWN
 
 # Ty, BOOL, … live in typecheck; imported lazily there to avoid a cycle.
 
@@ -157,8 +156,14 @@ class BuiltinChecks:
             ctx = self.quant
         finally:
             self.quant = None
+        for sub in ast.walk(body):
+            if isinstance(sub, (ast.For, ast.Within, ast.Latch)):
+                word = {ast.For: "'for'", ast.Within: "'within'", ast.Latch: "latch()"}[type(sub)]
+                self.error(sub.span, f"{word} cannot be used inside {e.func}(): an element has no history; "  # type: ignore[attr-defined]
+                                     f"apply it to the quantifier instead, e.g. ({e.func}(…)) for 1 s")
+                return e, ANY
         if ctx.array is None:
-            self.error(e.args[0].span, f"{e.func}() needs an array term in its condition, such as "  # type: ignore[attr-defined]
+            self.error(e.span, f"{e.func}() needs an array term in its condition, such as "  # type: ignore[attr-defined]
                                        "'topic /diagnostics.status[*].level' or 'topic /scan.ranges[0:90]'")
             return e, ANY
         return ast.Quant(e.func, ctx.array, body, span=e.span), (BARE if e.func == "count" else BOOL)
@@ -256,9 +261,4 @@ class BuiltinChecks:
         return out, (BOOL if e.func == "inside" else length)
 
 
-def fold_unknown(value: Any) -> bool:
-    """True when folding produced the unknown value (kept unfolded: the engine says unknown)."""
-    return value is UNKNOWN
-
-
-__all__ = ["BuiltinChecks", "fold_unknown", "Optional"]
+__all__ = ["BuiltinChecks"]

@@ -1,0 +1,170 @@
+"""Language version 2 (LANGUAGE.md §10–15): every error the contract names, with its place;
+fmt round-trips every construct; folding means what evaluation means (issue 20)."""
+import textwrap
+
+import pytest
+
+from rubass.engine import Engine
+from rubass.lang import SpecError, check_text, format_spec, load_spec, parse_text
+
+LIB = """\
+actions:
+  stop: {plugin: publish, topic: /cmd_vel, type: geometry_msgs/Twist}
+  warn: {plugin: log}
+  board_stop: {plugin: log}
+"""
+HEAD = 'import "actions.yaml";\naction primitive stop, warn;\n'
+
+
+def errors(tmp_path, spec):
+    """[(line, col, message)] of a spec's errors."""
+    (tmp_path / "actions.yaml").write_text(LIB)
+    path = tmp_path / "s.rbs"
+    path.write_text(textwrap.dedent(spec))
+    with pytest.raises(SpecError) as info:
+        load_spec(str(path))
+    return [(d.span.line, d.span.col, d.message) for d in info.value.diagnostics]
+
+
+def ok(tmp_path, spec):
+    (tmp_path / "actions.yaml").write_text(LIB)
+    path = tmp_path / "s.rbs"
+    path.write_text(spec)
+    return load_spec(str(path))
+
+
+CASES = [
+    ("unknown attribute", HEAD + '@owner("me") entity e { rules: r: topic /v.x > 1; }\nif (e.r) then { stop; }\n',
+     (3, 1, "unknown attribute '@owner' on a entity; known: @id, @hazard, @title, @ref")),
+    ("duplicate id", HEAD + 'entity e { rules:\n  @id("SR-1") r: topic /v.x > 1;\n  @id("SR-1") q: topic /v.x > 2;\n}\n'
+     'if (e.r) then { stop; }\nif (e.q) then { warn; }\n', (5, 3, 'duplicate id "SR-1"; first given at')),
+    ("id takes one string", HEAD + '@id("A", "B") entity e { rules: r: topic /v.x > 1; }\nif (e.r) then { stop; }\n',
+     (3, 1, "@id takes one string, got 2")),
+    ("hazard needs a string", HEAD + 'entity e { rules: r: topic /v.x > 1; }\n@hazard() if (e.r) then { stop; }\n',
+     (4, 1, "@hazard takes one or more strings, got 0")),
+    ("polygon of two vertices", HEAD + "const A = polygon((0 m, 0 m), (1 m, 0 m));\n"
+     "entity e { rules: r: inside(topic /p.x, topic /p.y, A); }\nif (e.r) then { stop; }\n",
+     (3, 11, "a polygon needs at least three vertices, not 2")),
+    ("polygon mixing dimensions", HEAD + "const A = polygon((0 m, 0 m), (1, 0), (1 m, 1 m));\n"
+     "entity e { rules: r: inside(topic /p.x, topic /p.y, A); }\nif (e.r) then { stop; }\n",
+     (3, 11, "polygon() mixes lengths and numbers without a unit")),
+    ("polygon vertex not a length", HEAD + "const A = polygon((0 s, 0 s), (1 s, 0 s), (1 s, 1 s));\n"
+     "entity e { rules: r: inside(topic /p.x, topic /p.y, A); }\nif (e.r) then { stop; }\n",
+     (3, 20, "a vertex's coordinate must be a length, not a time")),
+    ("self-intersecting polygon", HEAD + "const A = polygon((0 m, 0 m), (4 m, 3 m), (4 m, 0 m), (0 m, 3 m));\n"
+     "entity e { rules: r: inside(topic /p.x, topic /p.y, A); }\nif (e.r) then { stop; }\n",
+     (3, 11, "edges 1 and 3 cross: the polygon is self-intersecting")),
+    ("inside with a time", HEAD + "const A = polygon((0 m, 0 m), (4 m, 0 m), (4 m, 3 m));\n"
+     "entity e { rules: r: inside(age(topic /p), topic /p.y, A); }\nif (e.r) then { stop; }\n",
+     (4, 29, "inside() X is a time, the polygon's vertices a length")),
+    ("array term outside an array function", HEAD + "entity e { rules: r: topic /scan.ranges[0:90] < 1 m; }\n"
+     "if (e.r) then { stop; }\n", (3, 22, "an array term ('[*]' or '[A:B]') can only be used inside")),
+    ("nested quantifiers", HEAD + "entity e { rules: r: any(any(topic /d.s[*].l > 1)); }\nif (e.r) then { stop; }\n",
+     (3, 26, "quantifiers cannot be nested: any() inside any()")),
+    ("two arrays in one quantifier", HEAD + "entity e { rules: r: any(topic /d.a[*] > 1 and topic /d.b[*] > 1); }\n"
+     "if (e.r) then { stop; }\n", (3, 48, "two arrays in one any()")),
+    ("quantifier without an array", HEAD + "entity e { rules: r: any(topic /d.a > 1); }\nif (e.r) then { stop; }\n",
+     (3, 22, "any() needs an array term in its condition")),
+    ("for inside a quantifier", HEAD + "entity e { rules: r: any(topic /d.a[*] > 1 for 1 s); }\n"
+     "if (e.r) then { stop; }\n", (3, 44, "'for' cannot be used inside any()")),
+    ("two slices in one path", HEAD + "entity e { rules: r: any(topic /d.a[*].b[0:2] > 1); }\nif (e.r) then { stop; }\n",
+     (3, 26, "a field path can run over one array only")),
+    ("rate of a topic", HEAD + "entity e { rules: r: rate(topic /odom) > 1; }\nif (e.r) then { stop; }\n",
+     (3, 22, "rate() takes a topic field")),
+    ("stamp_age of a field", HEAD + "entity e { rules: r: stamp_age(topic /odom.header) > 1 s; }\nif (e.r) then { stop; }\n",
+     (3, 32, "stamp_age() takes a topic, not a field: write 'stamp_age(topic /odom)'")),
+    ("within without a unit", HEAD + "entity e { rules: r: topic /b.p within 2; }\nif (e.r) then { stop; }\n",
+     (3, 40, "the duration of 'within' needs a unit of time: write '2 s'")),
+    ("active of an undeclared action", HEAD + "entity e { rules: r: active(stpo); }\nif (e.r) then { stop; }\n",
+     (3, 29, "active() names 'stpo', which is not a declared action")),
+    ("a behaviour that holds itself on", HEAD + "entity e { rules: r: topic /v.x > 1; }\n"
+     "hold: if (e.r or active(stop)) then { stop; }\n",
+     (4, 1, "hold depends on active() of one of its own actions, so it could hold itself on: hold -> active(stop) -> hold")),
+    ("self-hold through a rule and another behaviour", HEAD + "entity e { rules: r: active(warn); }\n"
+     "a: if (e.r) then { stop; }\nb: if (active(stop)) then { warn; }\n",
+     (5, 1, "b depends on active() of one of its own actions, so it could hold itself on: "
+     "b -> active(stop) -> a -> e.r -> active(warn) -> b")),
+    ("duplicate behaviour name", HEAD + "entity e { rules: r: topic /v.x > 1; }\n"
+     "e: if (e.r) then { stop; }\n", (4, 1, "duplicate name 'e' (a behaviour)")),
+    ("latch arguments", HEAD + "entity e { rules: r: latch(topic /v.x > 1); }\nif (e.r) then { stop; }\n",
+     (3, 22, "latch() is written latch(SET, RESET)")),
+    ("a number too large", HEAD + "entity e { rules: r: topic /v.x > 1e999; }\nif (e.r) then { stop; }\n",
+     (3, 35, "the number '1e999' is too large")),
+    ("for of a division by zero", HEAD + "entity e { rules: r: topic /v.x > 1 for (1 s / 0); }\nif (e.r) then { stop; }\n",
+     (3, 46, "the duration of 'for' is not a number")),
+    ("sqrt of an odd power has no SI dimension", HEAD + "entity e { rules: r: sqrt(1 m) > 1 m; }\n"
+     "if (e.r) then { stop; }\n", (3, 32, "compares a sqrt of an odd power with a length")),
+    ("sqrt of a time compared with a time", HEAD + "entity e { rules: r: sqrt(age(topic /t)) > 1 s; }\n"
+     "if (e.r) then { stop; }\n", (3, 42, "compares a sqrt of an odd power with a time")),
+]
+
+
+@pytest.mark.parametrize("name,spec,want", CASES, ids=[c[0] for c in CASES])
+def test_v2_errors_name_their_place(tmp_path, name, spec, want):
+    got = errors(tmp_path, spec)
+    assert any(g[0] == want[0] and g[1] == want[1] and want[2] in g[2] for g in got), got
+
+
+ALL = HEAD + textwrap.dedent("""\
+    const AREA = polygon((0 m, 0 m), (4 m, 0 m), (4 m, 3 m), (0 m, 3 m));
+    @hazard("H2") @ref("ISO 3691-4 5.2") entity base: controller { rules:
+      @id("SR-3") @title("Speed limit near people")
+      too_fast: latch(topic /odom.twist.twist.linear.x > 0.5 m/s, (topic /odom.twist.twist.linear.x < 0.4 m/s) for 1 s);
+      front: min(topic /scan.ranges[0:90]) < 0.4 m or max(topic /scan.ranges[-90:]) < 0.1 m;
+      diag: count(topic /diag.status[*].level >= 2) > 1 and all(topic /diag.status[:3].level < 3);
+      zone: inside(topic /odom.pose.pose.position.x, topic /odom.pose.pose.position.y, AREA)
+        and distance(topic /odom.pose.pose.position.x, topic /odom.pose.pose.position.y, AREA) < 0.5 m;
+      stale: stamp_age(topic /scan) > 0.2 s or rate(topic /odom.twist.twist.linear.x) > 2 m/s^2;
+      hold: topic /bumper.pressed for 0.1 s within 2 s;
+    }
+    @id("SR-3.1") @hazard("H2", "H7") @title("Stop on overspeed")
+    overspeed: if (base.too_fast) then { stop; }
+    if ((active(stop) for 0.5 s) and base.hold) then { warn("still moving"); }
+    """)
+
+
+def test_fmt_round_trips_every_v2_construct(tmp_path):
+    out = format_spec(parse_text(ALL), ALL)
+    assert parse_text(out) == parse_text(ALL)
+    assert format_spec(parse_text(out), out) == out  # canonical: a fixed point
+    spec = ok(tmp_path, out)
+    assert spec.behaviour("overspeed").attrs == {"id": ("SR-3.1",), "hazard": ("H2", "H7"),
+                                                  "title": ("Stop on overspeed",)}
+    too_fast = spec.rule("base.too_fast")
+    assert too_fast.attrs == {"hazard": ("H2",), "ref": ("ISO 3691-4 5.2",), "id": ("SR-3",),
+                              "title": ("Speed limit near people",)}
+    assert spec.rule("base.front").attrs == {"hazard": ("H2",), "ref": ("ISO 3691-4 5.2",)}
+    assert spec.behaviour("2").label == "behaviour 2" and spec.behaviour("overspeed").label == "overspeed"
+    # one evaluation order: the behaviour that starts stop comes before the one reading active(stop)
+    assert spec.evaluation.index("b:1") < spec.evaluation.index("b:2")
+
+
+def test_star_and_full_slice_are_one_thing():
+    a = parse_text("entity e { rules: r: any(topic /d.s[*].l > 1); }")
+    b = parse_text("entity e { rules: r: any(topic /d.s[ : ].l > 1); }")
+    assert a == b
+
+
+def test_version_1_specs_keep_their_meaning(tmp_path):
+    v1 = HEAD + "entity e { rules: r: (topic /v.x > 1) for 0.5 s; }\nif (e.r) then { stop; }\n"
+    spec = ok(tmp_path, v1)
+    engine = Engine(spec, 0.0)
+    engine.evaluate_all(0.0)
+    engine.on_message("/v", 1.0, {"x": 2.0})
+    assert [(e.time, e.kind) for e in engine.advance(5.0) if e.kind == "start"] == [(1.5, "start")]
+
+
+FOLDS = [  # issue 20.1: what folding decides must be what run time decides (unknown never fires)
+    ("not (sqrt(-1) < 1)", None), ("1/0 > 1", None), ("min(5, 1/0) < 10", None), ("min(1/0, 5) < 10", None),
+    ("max(0, sqrt(-1)) >= 0", None), ("min(5, 1) < 10", True), ("not (2 > 1)", False),
+]
+
+
+@pytest.mark.parametrize("expr,want", FOLDS)
+def test_folding_means_what_evaluation_means(tmp_path, expr, want):
+    spec = ok(tmp_path, HEAD + f"entity e {{ rules: r: {expr}; }}\nif (e.r) then {{ stop; }}\n")
+    engine = Engine(spec, 0.0)
+    events = engine.evaluate_all(0.0)
+    value = engine.rule_value("e.r")
+    assert (None if value is not True and value is not False else value) == want
+    assert [e for e in events if e.kind == "start"] == ([] if want is not True else events[-1:])
