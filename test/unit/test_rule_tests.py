@@ -254,3 +254,22 @@ def test_command_line_exit_codes():
                        capture_output=True, text=True)
     assert r.returncode == 2 and "/nonexistent.test.yaml: error: cannot read" in r.stderr
     assert r.stdout.strip().endswith("0 passed, 0 failed")
+
+
+def test_docs_testing_md_examples_run_and_pass(tmp_path, capsys):
+    """docs/testing.md: its spec and every test file on the page pass, as the page says."""
+    import re
+    import shutil
+
+    text = open(os.path.join(ROOT, "docs", "testing.md"), encoding="utf-8").read()
+    (spec,) = re.findall(r"```rubass\n(.*?)```", text, re.S)
+    (tmp_path / "robot.rbs").write_text(spec)
+    shutil.copy(os.path.join(ROOT, "docs", "examples", "actions.yaml"), tmp_path / "actions.yaml")
+    files = [b for b in re.findall(r"```yaml\n(.*?)```", text, re.S) if b.startswith("spec:")]
+    assert len(files) >= 2
+    for k, body in enumerate(files):
+        path = tmp_path / f"t{k}.test.yaml"
+        path.write_text(body)
+        code, out, err = run(capsys, str(path))
+        assert code == 0, out + err
+        assert "FAIL" not in out and not err
