@@ -3,7 +3,7 @@ units; the FieldModel the checker asks, and the warnings for topics and nodes it
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Dict, Iterator, List, Optional, Tuple
+from typing import Dict, Iterator, List, Optional, Set, Tuple
 
 from . import ast
 from .errors import Diagnostic, did_you_mean
@@ -35,10 +35,12 @@ class SystemModel:
     units: UnitTable = field(default_factory=dict)
     topic_units: Dict[str, Dict[str, Dimension]] = field(default_factory=dict)
     source: str = "the system model"
+    unpublished: Set[str] = field(default_factory=set)  # known topics nobody publishes (live graph)
 
     def __post_init__(self) -> None:
         self.topics = {norm_topic(t): ty for t, ty in self.topics.items()}
         self.topic_units = {norm_topic(t): u for t, u in self.topic_units.items()}
+        self.unpublished = {norm_topic(t) for t in self.unpublished}
         if self.nodes is not None:
             self.nodes = sorted({norm_topic(n) for n in self.nodes})
 
@@ -98,9 +100,13 @@ def graph_warnings(spec: ast.Spec, model: SystemModel) -> List[Diagnostic]:
     seen = set()
     for ref in sorted(_topic_refs(spec), key=lambda r: (r.span.line, r.span.col)):
         name = norm_topic(ref.topic)
-        if name in seen or name in model.topics:
+        if name in seen or (name in model.topics and name not in model.unpublished):
             continue
         seen.add(name)
+        if name in model.topics:
+            out.append(Diagnostic(ref.span, f"topic '{ref.topic}' has no publisher in {model.source} "
+                                            "(only subscribers): its data would never come", "warning"))
+            continue
         out.append(Diagnostic(ref.span, f"topic '{ref.topic}' is not in {model.source}"
                                         f"{did_you_mean(name, model.topics)}", "warning"))
     if model.nodes is None:

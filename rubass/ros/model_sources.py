@@ -74,8 +74,10 @@ def live_model(uri: Optional[str] = None, timeout: float = 2.0) -> SystemModel:
                     break
                 except DefinitionError:
                     continue
+    published = {t for t, ns in pubs if ns}
     model = SystemModel({t: ty for t, ty in types.items() if ty != "*"}, nodes, registry,
-                        source=f"the live graph at {master.master_uri}")
+                        source=f"the live graph at {master.master_uri}",
+                        unpublished={t for t in types if t not in published})
     kinds = _joint_kinds(master)
     units = joint_state_units(kinds) if kinds else {}
     for topic, ty in model.topics.items():

@@ -89,13 +89,16 @@ def test_live_model_reads_types_nodes_foreign_definitions_and_joint_kinds(graph)
 def test_check_live_warns_of_unknown_topics_and_nodes(graph, write):
     path = write("s.rbs", f'import "{LIB}";\naction primitive stop;\n'
                           "entity base: drivr {\n  rules:\n    r: topic /cmd_vl.linear.x > 1 m/s;\n"
-                          "    hot: cpu(node drivr) > 50 %;\n}\nif (base.r) then { stop; }\n")
+                          "    hot: cpu(node drivr) > 50 %;\n    f: topic /odom_filtered.linear.x > 1;\n}\n"
+                          "if (base.r) then { stop; }\n")
     code, out, err = rubass(graph, "check", "--live", path)
     assert code == 0, err
     assert f"{path}:3:14: warning: node 'drivr' is not in the live graph at {graph.master.uri}; " \
            "did you mean '/driver'?" in err
     assert f"{path}:5:8: warning: topic '/cmd_vl' is not in the live graph" in err
     assert "did you mean '/cmd_vel'?" in err
+    assert f"{path}:7:8: warning: topic '/odom_filtered' has no publisher in the live graph at " \
+           f"{graph.master.uri} (only subscribers): its data would never come" in err
 
 
 def test_model_live_then_check_with_no_master(graph, write, tmp_path):

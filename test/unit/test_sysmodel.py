@@ -229,3 +229,21 @@ def test_graph_warnings_with_suggestions():
 def test_no_node_warnings_when_the_source_lists_no_nodes():
     spec = parse_source(Source("s.rbs", SPEC))
     assert [d.message.split(" is")[0] for d in graph_warnings(spec, model())] == ["topic '/cmd_vell'"]
+
+
+def test_new_units_in_a_spec():
+    from rubass.lang.errors import SpecError
+    from rubass.lang.loader import check_text
+
+    c = check_text("const V1 = 12 V;\nconst I1 = 500 mA;\nconst T1 = 40 degC;\nconst P1 = 1 kPa;\n"
+                   "const W = V1 * I1;\nconst AA = 2 rad/s^2;\n")
+    assert c.consts == {"V1": 12.0, "I1": 0.5, "T1": 40.0, "P1": 1000.0, "W": 6.0, "AA": 2.0}
+    with pytest.raises(SpecError, match="cannot add or subtract a voltage and a current"):
+        check_text("const X = 12 V + 1 A;\n")
+
+
+def test_a_topic_nobody_publishes_is_a_warning():
+    spec = parse_source(Source("s.rbs", SPEC.replace("/cmd_vell", "/scan")))
+    warnings = graph_warnings(spec, model(unpublished={"scan"}))
+    assert [f"{d.span}: {d.message}" for d in warnings] == [
+        "s.rbs:4:11: topic '/scan' has no publisher in the system model (only subscribers): its data would never come"]
