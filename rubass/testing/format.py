@@ -1,6 +1,7 @@
 """Reading a test file (TESTING.md) into plain data, with the line of everything for errors."""
 from __future__ import annotations
 
+import math
 import os
 from dataclasses import dataclass, field
 from typing import Any, Dict, List, Optional, Tuple
@@ -13,6 +14,8 @@ from .yamlpos import LDict, LList, TestFileError, load
 
 UNSET: Any = object()  # a node-sample value the sample leaves out
 DEFAULT_TOLERANCE = 1e-3
+MAX_TIME = 24 * 3600.0  # a test simulates at most a day (ticks at 50 Hz: 4.3 million)
+MAX_MESSAGES = 1_000_000  # per test: each is a real message object
 
 
 @dataclass
@@ -118,14 +121,17 @@ class _Reader:
             q = parse_quantity(str(value))
             if q is not None and q[1] == ():
                 q = (q[0], dim) if dim != () else q
-        if q is None or q[1] != dim or q[0] != q[0]:
-            raise self.fail(line, f"{what}: '{value}' is not a quantity in {unit}")
+        if q is None or q[1] != dim or not math.isfinite(q[0]):
+            raise self.fail(line, f"{what}: '{value}' is not a (finite) quantity in {unit}")
         if q[0] < 0 and not negative:
             raise self.fail(line, f"{what} must not be negative")
         return float(q[0])
 
     def time(self, value: Any, line: int, what: str) -> float:
-        return self.quantity(value, line, what, TIME, "seconds, e.g. 1.5 s or 200 ms")
+        t = self.quantity(value, line, what, TIME, "seconds, e.g. 1.5 s or 200 ms")
+        if t > MAX_TIME:
+            raise self.fail(line, f"{what}: {t:g} s is longer than a test may run ({MAX_TIME:g} s)")
+        return t
 
     # -- the file ---------------------------------------------------------------------------
     def read(self) -> TestFile:
@@ -151,7 +157,7 @@ class _Reader:
 
     def case(self, value: Any, line: int, i: int) -> Case:
         t = self.mapping(value, line, "a test", ("name", "covers", "duration", "topics", "nodes", "expect",
-                                                 "tolerance"), ("expect",))
+                                                 "tolerance"))
         name = str(t.get("name", f"test {i + 1}"))
         covers = t.get("covers", LList())
         covers = [covers] if isinstance(covers, str) else self.seq(covers, t.at("covers"), "covers")
@@ -164,7 +170,7 @@ class _Reader:
         nodes = self.mapping(t.get("nodes", LDict()), t.at("nodes"), "nodes", tuple(t.get("nodes") or ()))
         for node, samples in nodes.items():
             self.node(case, str(node), samples, nodes.at(node))
-        expects = self.seq(t["expect"], t.at("expect"), "expect")
+        expects = self.seq(t.get("expect", LList()), t.at("expect"), "expect")
         case.expects = [self.expect(e, expects.at(k)) for k, e in enumerate(expects)]
         return case
 
@@ -219,7 +225,10 @@ class _Reader:
         if len(lengths) != 1:
             raise self.fail(t.at("fields"), f"the fields of {topic} have series of different lengths "
                                             f"({', '.join(str(len(s)) for _, s in steps)} steps)")
-        for k in range(lengths.pop()):
+        n = lengths.pop()
+        if len(case.messages) + n > MAX_MESSAGES:
+            raise self.fail(t.line, f"more than {MAX_MESSAGES} messages in one test")
+        for k in range(n):
             parts = [(path, s[k]) for path, s in steps if s[k] is not GAP]
             if parts:
                 line = t.at("values") if "values" in t else t.at("fields")

@@ -100,8 +100,11 @@ def _scalar(slot: str, value: Any, where: str) -> Any:
 
         if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
             raise MessageError(f"{where} is a {slot}: {value!r} is not a number of seconds")
-        return (genpy.Time if slot == "time" else genpy.Duration).from_sec(float(value)) if value else \
-            (genpy.Time() if slot == "time" else genpy.Duration())
+        try:
+            return (genpy.Time if slot == "time" else genpy.Duration).from_sec(float(value)) if value else \
+                (genpy.Time() if slot == "time" else genpy.Duration())
+        except (TypeError, ValueError, OverflowError) as exc:  # e.g. a negative time
+            raise MessageError(f"{where} is a {slot}: {value!r} cannot be one ({exc})") from None
     return None  # a message: handled by the caller
 
 
