@@ -3,20 +3,28 @@ from __future__ import annotations
 
 import re
 from dataclasses import dataclass, field
-from typing import Any, Callable, Dict, List, Optional, Tuple
+from typing import Any, Callable, Dict, Iterable, List, Optional, Tuple
 
 import yaml
 
 from .errors import Diagnostic, did_you_mean
 from .grammar import KEYWORDS
 from .source import Source, SourceSet, Span
-from .units import FREQUENCY, TIME, Dimension, parse_quantity
+from .units import FREQUENCY, SPEED, TIME, Dimension, dim, dimension_name, parse_quantity
 
-BUILTIN_PLUGINS = ("publish", "serial", "service", "log")
+BUILTIN_PLUGINS = ("publish", "serial", "service", "log", "limit")
 CUSTOM_PLUGIN_RE = re.compile(r"[A-Za-z_][A-Za-z0-9_]*(?:\.[A-Za-z_][A-Za-z0-9_]*)*:[A-Za-z_][A-Za-z0-9_]*")
 MSG_TYPE_RE = re.compile(r"[A-Za-z_][A-Za-z0-9_]*/[A-Za-z_][A-Za-z0-9_]*")
 LOG_LEVELS = ("debug", "info", "warn", "error")
 PHASES = ("start", "hold", "release")
+ANGULAR_SPEED = dim(rad=1, s=-1)
+LIMIT_AXES: Dict[str, Tuple[Dimension, str]] = {  # axis -> (dimension, its SI unit)
+    **{f"linear_{a}": (SPEED, "m/s") for a in "xyz"},
+    **{f"angular_{a}": (ANGULAR_SPEED, "rad/s") for a in "xyz"},
+}
+_UNITS_OF = {"m/s": "m/s, cm/s or km/h", "rad/s": "rad/s or deg/s"}
+TWIST_TYPES = ("geometry_msgs/Twist", "geometry_msgs/TwistStamped")
+TOPIC_PLUGINS = ("publish", "limit")  # plugins that publish on `topic`, arbitrated by priority
 
 
 @dataclass(frozen=True)
@@ -28,6 +36,7 @@ class ActionDef:
     params: Dict[str, Any] = field(compare=False)
     latch: bool = False
     span: Span = field(default=Span("<none>", 0, 0), compare=False)
+    priority: int = 0  # among actions publishing on the same topic, the highest publishes (§16)
 
     @property
     def is_custom(self) -> bool:
@@ -93,6 +102,13 @@ def _int(n: _Node, key: str) -> Tuple[Any, Optional[str]]:
     return v, None
 
 
+def _priority(n: _Node, key: str) -> Tuple[Any, Optional[str]]:
+    v = n.value()
+    if isinstance(v, bool) or not isinstance(v, int):
+        return None, f"'{key}' must be an integer (higher wins on a shared topic), got {v!r}"
+    return v, None
+
+
 def _mapping(n: _Node, key: str) -> Tuple[Any, Optional[str]]:
     v = n.value()
     if v is None:
@@ -112,7 +128,38 @@ def _quantity(d: Dimension, unit: str, example: str) -> Checker:
     return check
 
 
-_COMMON: Dict[str, Checker] = {"latch": _bool, "description": _string()}
+def _a(noun: str) -> str:
+    return ("an " if noun[:1] in "aeiou" else "a ") + noun
+
+
+def _range(d: Dimension, unit: str) -> Checker:
+    """[min, max] with units of dimension d (a bare 0 needs none); SI floats, min <= max."""
+    units = _UNITS_OF[unit]
+    what = _a(dimension_name(d))
+
+    def check(n: _Node, key: str) -> Tuple[Any, Optional[str]]:
+        v = n.value()
+        if not isinstance(v, list) or len(v) != 2:
+            return None, f"'{key}' must be a range [min, max] such as [-0.2 {unit}, 0.2 {unit}], got {v!r}"
+        out = []
+        for item in v:
+            q = parse_quantity(item) if isinstance(item, str) else (
+                (float(item), ()) if isinstance(item, (int, float)) and not isinstance(item, bool) else None)
+            if q is None or q[0] != q[0]:
+                return None, f"'{key}': {item!r} is not a quantity; write a number with a unit ({units})"
+            if not q[1] and q[0] != 0:
+                return None, f"'{key}': {item!r} needs a unit ({units}), such as '{item} {unit}'"
+            if q[1] and q[1] != d:
+                return None, f"'{key}' takes {what} ({units}), got {item!r} ({_a(dimension_name(q[1]))})"
+            out.append(q[0])
+        if out[0] > out[1]:
+            return None, f"'{key}': min {v[0]!r} is greater than max {v[1]!r}"
+        return (out[0], out[1]), None
+    return check
+
+
+_COMMON: Dict[str, Checker] = {"latch": _bool, "description": _string(), "priority": _priority}
+_TOPIC = _string(re.compile(r"~?/?[A-Za-z_][\w/]*"), "a topic name")
 
 # plugin -> {key: (checker, required, default)}
 SCHEMAS: Dict[str, Dict[str, Tuple[Checker, bool, Any]]] = {
@@ -141,6 +188,14 @@ SCHEMAS: Dict[str, Dict[str, Tuple[Checker, bool, Any]]] = {
     "log": {
         "level": (_choice(LOG_LEVELS), False, "warn"),
         "message": (_string(), False, None),
+    },
+    "limit": {
+        "input": (_TOPIC, True, None),
+        "topic": (_TOPIC, True, None),
+        "type": (_choice(TWIST_TYPES), False, TWIST_TYPES[0]),
+        "timeout": (_quantity(TIME, "time", "0.5 s"), False, 0.5),
+        "rate": (_quantity(FREQUENCY, "frequency", "20 Hz"), False, 20.0),
+        **{axis: (_range(d, unit), False, None) for axis, (d, unit) in LIMIT_AXES.items()},
     },
 }
 
@@ -226,7 +281,10 @@ def parse_library(src: Source) -> Tuple[Dict[str, ActionDef], List[Diagnostic]]:
         diags.extend(problems)
         if action is not None:
             out[name] = action
-    return out, diags
+    conflicts = priority_conflicts(out.values())
+    for d in conflicts:
+        out = {k: v for k, v in out.items() if v.span != d.span}
+    return out, diags + conflicts
 
 
 def _key(node: yaml.Node) -> str:
@@ -275,7 +333,39 @@ def _action(name: str, span: Span, node: _Node, file: str) -> Tuple[Optional[Act
                 params[key] = default
     if plugin == "serial" and not any(params.get(k) for k in ("on_start", "on_hold", "on_release")):
         diags.append(Diagnostic(span, f"{where}: a serial action needs at least one of on_start, on_hold, on_release"))
+    if plugin == "limit" and not diags:
+        diags += _limit_problems(where, span, params, fields)
     if diags:
         return None, diags
     latch = bool(params.pop("latch", False))
-    return ActionDef(name, plugin, params, latch, span), []
+    priority = int(params.pop("priority", 0))
+    return ActionDef(name, plugin, params, latch, span, priority), []
+
+
+def _limit_problems(where: str, span: Span, params: Dict[str, Any], fields: Dict[str, Any]) -> List[Diagnostic]:
+    out = []
+    if not any(params.get(axis) for axis in LIMIT_AXES):
+        out.append(Diagnostic(span, f"{where}: a limit action needs at least one axis range "
+                                    f"({', '.join(LIMIT_AXES)}), such as 'linear_x: [-0.1 m/s, 0.2 m/s]'"))
+    if params["input"] == params["topic"]:
+        out.append(Diagnostic(fields["topic"][1].span, f"{where}: 'topic' must differ from 'input' "
+                                                       f"({params['input']}): it would filter its own output"))
+    return out
+
+
+def priority_conflicts(actions: Iterable[ActionDef], resolve: Callable[[str], str] = lambda t: t) -> List[Diagnostic]:
+    """Two actions with the same priority publishing on the same topic (§16): one error each
+    after the first, at its definition. `resolve` maps topic names (the monitor resolves them)."""
+    seen: Dict[Tuple[str, int], ActionDef] = {}
+    out: List[Diagnostic] = []
+    for a in sorted(actions, key=lambda a: (a.span.file, a.span.line, a.span.col, a.name)):
+        if a.plugin not in TOPIC_PLUGINS:
+            continue
+        topic = resolve(a.params["topic"])
+        first = seen.setdefault((topic, a.priority), a)
+        if first is not a:
+            place = f"line {first.span.line}" if first.span.file == a.span.file else str(first.span)
+            out.append(Diagnostic(a.span, f"action '{a.name}': same priority ({a.priority}) as action "
+                                          f"'{first.name}' ({place}), and both publish on {topic}; which one "
+                                          f"publishes must not be left to chance: give one a higher 'priority'"))
+    return out

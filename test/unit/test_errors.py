@@ -130,7 +130,7 @@ def test_render_is_compiler_style_with_caret(write, tmp_path):
 
 LIB_CASES = [
     ("unknown plugin", "actions:\n  stop:\n    plugin: publsh\n",
-     (3, 13, "action 'stop': unknown plugin 'publsh' (built-ins: publish, serial, service, log; "
+     (3, 13, "action 'stop': unknown plugin 'publsh' (built-ins: publish, serial, service, log, limit; "
              "custom: 'package.module:Class'); did you mean 'publish'?")),
     ("missing key", "actions:\n  stop:\n    plugin: publish\n    topic: /cmd_vel\n",
      (2, 3, "action 'stop': missing key 'type' (plugin 'publish' needs it)")),

@@ -77,6 +77,9 @@ class ActionPlugin:
     def periodic(self) -> None:
         """Called every `period` seconds."""
 
+    def wake(self) -> None:
+        """Have periodic() called now (its runner replaces this; a topic handed over by priority)."""
+
     def close(self) -> None:
         """Release resources at shutdown or when a reload drops the action."""
 
@@ -151,6 +154,9 @@ def make_plugin(action: ActionDef) -> ActionPlugin:
     if action.plugin == "service":
         from .service import ServicePlugin
         return ServicePlugin(action)
+    if action.plugin == "limit":
+        from .limit import LimitPlugin
+        return LimitPlugin(action)
     from .log import LogPlugin
     return LogPlugin(action)
 

@@ -8,6 +8,7 @@ import genpy
 import roslib.message
 import rospy
 
+from .arbiter import take_seat
 from .base import ActionPlugin, ActionSetupError, Context
 
 
@@ -44,6 +45,7 @@ class PublishPlugin(ActionPlugin):
         super().__init__(action)
         self.period = 1.0 / float(self.params["rate"])
         self.pub: Optional[rospy.Publisher] = None
+        self.seat: Any = None
 
     def setup(self) -> None:
         cls = ros_class(roslib.message.get_message_class, self.params["type"], f"action '{self.name}'", "message")
@@ -57,11 +59,20 @@ class PublishPlugin(ActionPlugin):
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")  # rospy warns that queue_size is not set: on purpose
             self.pub = rospy.Publisher(self.params["topic"], cls, queue_size=None, tcp_nodelay=True)
+        # among the actions on this topic only the highest-priority active one publishes (§16)
+        self.seat = take_seat(self.params["topic"], self.name, self.action.priority, lambda: self.wake())
+
+    def _publish(self, msg: Any) -> bool:
+        """Publish if this action owns its topic; whether it did."""
+        with self.seat.turn() as mine:
+            if mine and self.pub is not None:
+                self.pub.publish(msg)
+            return mine and self.pub is not None
 
     def start(self, ctx: Context) -> None:
         assert self.pub is not None
-        self.pub.publish(self.msg)
-        if self.pub.get_num_connections() == 0:
+        self.seat.activate()
+        if self._publish(self.msg) and self.pub.get_num_connections() == 0:
             # not an error rospy would report: the message just went nowhere. A failure, so it is
             # logged, counted in /diagnostics and retried (0.05 s, 0.1 s, … then every 1 s); the
             # periodic publication also reaches a subscriber that connects later.
@@ -70,13 +81,18 @@ class PublishPlugin(ActionPlugin):
 
     def periodic(self) -> None:
         if self.active and self.pub is not None:
-            self.pub.publish(self.msg)
+            self._publish(self.msg)
 
     def release(self, ctx: Context) -> None:
-        if self.release_msg is not None and self.pub is not None:
-            self.pub.publish(self.release_msg)
+        try:
+            if self.release_msg is not None and self.pub is not None:
+                self._publish(self.release_msg)
+        finally:
+            self.seat.deactivate()  # after on_release: the next action on the topic is woken to publish
 
     def close(self) -> None:
+        if self.seat is not None:
+            self.seat.leave()
         if self.pub is not None:
             self.pub.unregister()
             self.pub = None

@@ -32,6 +32,7 @@ class ActionRunner:
         self._next_periodic = float("inf")
         self._last_log = 0.0
         self._thread: Optional[threading.Thread] = None
+        plugin.wake = self.wake  # type: ignore[method-assign]
 
     @property
     def active(self) -> bool:
@@ -107,6 +108,12 @@ class ActionRunner:
         else:
             items.pop(0)
         self._queue = collections.deque(items)
+
+    def wake(self) -> None:
+        """Run the plugin's periodic work now, and its period from now on (any thread)."""
+        with self._cond:
+            self._next_periodic = time.monotonic()
+            self._cond.notify()
 
     def stop(self, timeout: float = 2.0) -> None:
         with self._cond:

@@ -1,0 +1,1 @@
+"""Pure action logic (no ROS): arbitration of a shared topic by priority, velocity clamping."""

@@ -1,0 +1,156 @@
+"""The `limit` plugin (LANGUAGE.md §16): while active, every velocity command on `input` is
+republished on `topic` with the named axes clamped; no command for `timeout` means zero, at
+`rate`; while inactive, nothing.
+
+The input is read from set-up on (rospy.AnyMsg, tcp_nodelay), so the first command after a
+start is not lost to connection set-up and a start can republish the latest command at once.
+Each command is clamped and published on the subscriber's own thread (no hand-off), the zero
+commands on the runner's thread; one lock orders them, and the arbiter decides whether this
+action owns its topic at all.
+"""
+from __future__ import annotations
+
+import threading
+import time
+import warnings
+from typing import Any, Dict, Optional
+
+import roslib.message
+import rospy
+
+from ...actions.clamp import AXES, clamp_twist
+from .arbiter import take_seat
+from .base import ActionPlugin, Context
+from .publish import ros_class
+
+LOG_EVERY = 5.0
+
+
+class LimitPlugin(ActionPlugin):
+    def __init__(self, action: Any) -> None:
+        super().__init__(action)
+        self.period = 1.0 / float(self.params["rate"])
+        self.timeout = float(self.params["timeout"])
+        self.type = self.params["type"]
+        self.ranges: Dict[str, Any] = {axis: self.params.get(axis) for axis in AXES if self.params.get(axis)}
+        self._lock = threading.Lock()
+        self._on = False  # between start and release (the runner's `active` flips earlier, on submit)
+        self._raw: Optional[bytes] = None  # the latest command, as it came
+        self._raw_at = float("-inf")  # its arrival (time.monotonic())
+        self._due = False  # publish at the next periodic although a command is fresh (handed the topic)
+        self._last_log = float("-inf")
+        self.input_errors = 0
+        self.pub: Optional[rospy.Publisher] = None
+        self.sub: Optional[rospy.Subscriber] = None
+        self.seat: Any = None
+
+    def setup(self) -> None:
+        self.cls = ros_class(roslib.message.get_message_class, self.type, f"action '{self.name}'", "message")
+        self.stamped = self.type.endswith("Stamped")
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")  # synchronous publisher on purpose, as in `publish`
+            self.pub = rospy.Publisher(self.params["topic"], self.cls, queue_size=None, tcp_nodelay=True)
+        self.seat = take_seat(self.params["topic"], self.name, self.action.priority, self._handed_over)
+        self.sub = rospy.Subscriber(self.params["input"], rospy.AnyMsg, self._on_input, tcp_nodelay=True)
+
+    # -- the subscriber's thread -----------------------------------------------------------
+    def _on_input(self, raw: Any) -> None:
+        now = time.monotonic()
+        got = raw._connection_header.get("type", "")
+        if got != self.type:
+            self._fail(f"{self.params['input']} carries {got}, not {self.type} as action '{self.name}' says: "
+                       f"its commands are ignored (so after {self.timeout:g} s it publishes zero)")
+            return
+        with self._lock:
+            if not self._on:  # decoded only if a start needs it
+                self._raw, self._raw_at = raw._buff, now
+                return
+            msg = self._clamped(raw._buff)
+            if msg is None:
+                return
+            self._raw, self._raw_at = raw._buff, now
+            self._due = False
+            self._publish(msg)
+
+    # -- the runner's thread ---------------------------------------------------------------
+    def start(self, ctx: Context) -> None:
+        with self._lock:
+            self._on = True
+            self.seat.activate()
+            reached = self._publish(self._current())
+            self._due = False
+        if reached == 0:
+            raise IOError(f"no node subscribes to {self.params['topic']}: the limited command reached no one; "
+                          f"commands go on being published as they come")
+
+    def periodic(self) -> None:
+        with self._lock:
+            if not self._on:
+                return
+            if self._due or time.monotonic() - self._raw_at > self.timeout:
+                # no command for `timeout` is no command to keep moving: zero, at `rate`. Just
+                # handed the topic: the latest command if still fresh (else zero), heard at once
+                self._publish(self._current())
+                self._due = False
+
+    def release(self, ctx: Context) -> None:
+        with self._lock:
+            self._on = False
+            self.seat.deactivate()
+
+    def close(self) -> None:
+        with self._lock:
+            self._on = False
+        if self.seat is not None:
+            self.seat.leave()
+        for endpoint in (self.sub, self.pub):
+            if endpoint is not None:
+                endpoint.unregister()
+        self.sub = self.pub = None
+
+    # -- helpers (under self._lock) ----------------------------------------------------------
+    def _handed_over(self) -> None:
+        """The arbiter gave this action the topic: publish at once rather than at the next period."""
+        self._due = True
+        self.wake()
+
+    def _current(self) -> Any:
+        """The latest command clamped, if it came within `timeout`; else a zero command."""
+        if self._raw is not None and time.monotonic() - self._raw_at <= self.timeout:
+            msg = self._clamped(self._raw)
+            if msg is not None:
+                return msg
+        return self._zero()
+
+    def _clamped(self, buff: bytes) -> Any:
+        try:
+            msg = self.cls().deserialize(buff)
+        except Exception as exc:  # genpy.DeserializationError, struct.error: a broken publisher
+            self._raw = None
+            self._fail(f"a command on {self.params['input']} cannot be read ({exc.__class__.__name__}: {exc}): "
+                       f"ignored")
+            return None
+        clamp_twist(msg.twist if self.stamped else msg, self.ranges)
+        return msg
+
+    def _zero(self) -> Any:
+        msg = self.cls()
+        if self.stamped:
+            msg.header.stamp = rospy.get_rostime()
+        return msg
+
+    def _publish(self, msg: Any) -> int:
+        """Publish if this action owns the topic; the number of subscribers (-1: not the owner)."""
+        with self.seat.turn() as mine:
+            if not mine or self.pub is None:
+                return -1
+            self.pub.publish(msg)
+            return self.pub.get_num_connections()
+
+    def _fail(self, text: str) -> None:
+        """A bad input is no command (the timeout turns it into zero): logged, at most every 5 s."""
+        self.input_errors += 1
+        now = time.monotonic()
+        if now - self._last_log >= LOG_EVERY:
+            self._last_log = now
+            rospy.logerr("rubass: action '%s': %s (%d so far)", self.name, text, self.input_errors)

@@ -1,0 +1,152 @@
+"""The `limit` action on a live ROS 1 system (LANGUAGE.md §16): real publishers, real subscribers."""
+import os
+import time
+
+import pytest
+
+from conftest import ROOT
+from rosharness import PY, TWIST
+
+pytestmark = [pytest.mark.ros, pytest.mark.slow]
+
+STAMPED = "geometry_msgs/TwistStamped"
+ZERO = {"x": 0.0, "y": 0.0, "z": 0.0}
+
+
+def limit_spec(tmp_path, lib, actions="crawl", triggers=(("on", "/trig", "crawl"),)):
+    (tmp_path / "lib.yaml").write_text(lib)
+    rules = " ".join(f"{name}: topic {topic}.data > 0;" for name, topic, _ in triggers)
+    body = "".join(f"if (t.{name}) then {{ {action}; }}\n" for name, _, action in triggers)
+    path = tmp_path / "s.rbs"
+    path.write_text(f'import "lib.yaml";\naction primitive {actions};\nentity t {{ rules: {rules} }}\n' + body)
+    return str(path)
+
+
+def between(rec, lo, hi, topic="/safety_cmd"):
+    return [r for r in rec if r["kind"] == "recv" and r["topic"] == topic and lo <= r["wall"] < hi]
+
+
+def mark(rec, name):
+    return next(r["wall"] for r in rec if r["kind"] == "mark" and r["name"] == name)
+
+
+def sent(rec, topic, nth=-1):
+    return [r for r in rec if r["kind"] == "sent" and r["topic"] == topic][nth]["wall"]
+
+
+CRAWL = ("actions:\n  crawl:\n    plugin: limit\n    input: /cmd_vel\n    topic: /safety_cmd\n"
+         "    linear_x: [-0.1 m/s, 0.2 m/s]\n    angular_z: [-0.5 rad/s, 0.5 rad/s]\n")
+
+
+def test_limit_clamps_while_active_publishes_zero_after_timeout_and_nothing_while_inactive(ros, tmp_path):
+    ros.monitor(limit_spec(tmp_path, CRAWL))
+    fast = {"linear": {"x": 1.0, "y": 0.7}, "angular": {"z": -2.0}}
+    rec = ros.probe({
+        "listen": [{"topic": "/safety_cmd", "type": TWIST}],
+        "advertise": [{"topic": "/cmd_vel", "type": TWIST}, {"topic": "/trig", "type": "std_msgs/Float64"}],
+        "steps": [{"wait_subscribers": "/cmd_vel"}, {"wait_subscribers": "/trig"}, {"wait_publishers": "/safety_cmd"},
+                  {"sleep": 0.5}, {"mark": "inactive"},
+                  {"publish": "/cmd_vel", "msg": fast, "repeat": 6, "period": 0.05},
+                  {"publish": "/trig", "msg": {"data": 1.0}}, {"sleep": 0.2}, {"mark": "active"},
+                  {"publish": "/cmd_vel", "msg": fast, "repeat": 6, "period": 0.05},
+                  {"publish": "/cmd_vel", "msg": {"linear": {"x": 0.05}, "angular": {"z": 0.3}}},
+                  {"sleep": 1.2}, {"mark": "resume"},
+                  {"publish": "/cmd_vel", "msg": {"linear": {"x": -1.0}}}, {"sleep": 0.2},
+                  {"publish": "/trig", "msg": {"data": 0.0}}, {"sleep": 0.2}, {"mark": "released"},
+                  {"publish": "/cmd_vel", "msg": fast, "repeat": 10, "period": 0.05}, {"sleep": 0.8}],
+        "linger": 0.1})
+    t_on = sent(rec, "/trig", 0)
+    # inactive: commands flow, nothing is published
+    assert between(rec, 0, t_on) == []
+    # the start republishes the latest command (0.05 s old, fresh) clamped at once
+    first = between(rec, t_on, t_on + 1)[0]
+    assert first["wall"] - t_on < 0.1 and first["msg"]["linear"]["x"] == 0.2
+    # every command while active comes out clamped on the named axes, the others untouched
+    active = between(rec, mark(rec, "active"), mark(rec, "active") + 0.45)
+    assert len(active) == 7, active
+    assert [m["msg"]["linear"]["x"] for m in active] == [0.2] * 6 + [0.05]
+    assert [m["msg"]["angular"]["z"] for m in active] == [-0.5] * 6 + [0.3]
+    assert all(m["msg"]["linear"]["y"] == pytest.approx(0.7) for m in active[:6])
+    # no command for 0.5 s: zero, at 20 Hz, until a command comes again
+    last_cmd = sent(rec, "/cmd_vel", 12)
+    silence = between(rec, last_cmd + 0.01, mark(rec, "resume"))
+    assert silence and all(m["msg"] == {"linear": ZERO, "angular": ZERO} for m in silence), silence
+    assert 0.45 <= silence[0]["wall"] - last_cmd <= 0.65
+    assert 9 <= len(silence) <= 16  # 0.5 s of 1 s silence... at 20 Hz: ~14
+    gaps = [b["wall"] - a["wall"] for a, b in zip(silence, silence[1:])]
+    assert max(gaps) < 0.12 and sorted(gaps)[len(gaps) // 2] == pytest.approx(0.05, abs=0.01)
+    resumed = between(rec, mark(rec, "resume"), sent(rec, "/trig", 1))
+    assert resumed[0]["msg"]["linear"]["x"] == -0.1
+    assert all(m["msg"] == {"linear": ZERO, "angular": ZERO} for m in resumed[1:])  # 0.2 s: no timeout yet
+    assert len(resumed) == 1
+    # released: nothing more, whatever comes in
+    assert between(rec, sent(rec, "/trig", 1) + 0.05, 1e12) == []
+
+
+def test_limit_on_twist_stamped_keeps_the_header(ros, tmp_path):
+    lib = CRAWL.replace("topic: /safety_cmd\n", f"topic: /safety_cmd\n    type: {STAMPED}\n    timeout: 0.3 s\n"
+                                                  "    rate: 10 Hz\n")
+    ros.monitor(limit_spec(tmp_path, lib))
+    cmd = {"header": {"frame_id": "base_link", "seq": 7}, "twist": {"linear": {"x": 3.0}, "angular": {"z": 0.1}}}
+    rec = ros.probe({
+        "listen": [{"topic": "/safety_cmd", "type": STAMPED}],
+        "advertise": [{"topic": "/cmd_vel", "type": STAMPED}, {"topic": "/trig", "type": "std_msgs/Float64"}],
+        "steps": [{"wait_subscribers": "/cmd_vel"}, {"wait_subscribers": "/trig"}, {"wait_publishers": "/safety_cmd"},
+                  {"sleep": 0.5}, {"publish": "/trig", "msg": {"data": 1.0}}, {"sleep": 0.5}, {"mark": "cmd"},
+                  {"publish": "/cmd_vel", "msg": cmd}, {"sleep": 0.6}],
+        "linger": 0.1})
+    t_on = sent(rec, "/trig", 0)
+    at_start = between(rec, t_on, mark(rec, "cmd"))
+    assert at_start and at_start[0]["wall"] - t_on < 0.1  # nothing came yet: zero at once, then at 10 Hz
+    assert all(m["msg"]["twist"]["linear"] == ZERO for m in at_start)
+    assert all(m["msg"]["header"]["stamp"]["secs"] > 0 for m in at_start)  # stamped now
+    after = between(rec, mark(rec, "cmd"), 1e12)
+    assert after[0]["msg"]["header"]["frame_id"] == "base_link"
+    assert after[0]["msg"]["twist"]["linear"]["x"] == 0.2 and after[0]["msg"]["twist"]["angular"]["z"] == 0.1
+    zeros = [m for m in after[1:] if m["wall"] - after[0]["wall"] > 0.25]
+    assert zeros and all(m["msg"]["twist"]["linear"] == ZERO for m in zeros)
+
+
+def test_a_mistyped_input_is_no_command_so_the_limit_publishes_zero_and_logs_why(ros, tmp_path):
+    mon = ros.monitor(limit_spec(tmp_path, CRAWL))
+    rec = ros.probe({
+        "listen": [{"topic": "/safety_cmd", "type": TWIST}],
+        "advertise": [{"topic": "/cmd_vel", "type": STAMPED}, {"topic": "/trig", "type": "std_msgs/Float64"}],
+        "steps": [{"wait_subscribers": "/cmd_vel"}, {"wait_subscribers": "/trig"}, {"wait_publishers": "/safety_cmd"},
+                  {"sleep": 0.5}, {"publish": "/trig", "msg": {"data": 1.0}},
+                  {"publish": "/cmd_vel", "msg": {"twist": {"linear": {"x": 3.0}}}, "repeat": 20, "period": 0.05}],
+        "linger": 0.1})
+    got = between(rec, sent(rec, "/trig", 0), 1e12)
+    assert len(got) >= 10 and all(m["msg"] == {"linear": ZERO, "angular": ZERO} for m in got)
+    log = ros.log(mon)
+    assert "action 'crawl': /cmd_vel carries geometry_msgs/TwistStamped, not geometry_msgs/Twist" in log, log
+
+
+@pytest.mark.parametrize("lib, message", [
+    (CRAWL.replace("[-0.1 m/s, 0.2 m/s]", "[0.3 m/s, 0.2 m/s]"),
+     "lib.yaml:6:15: error: action 'crawl': 'linear_x': min '0.3 m/s' is greater than max '0.2 m/s'"),
+    (CRAWL.replace("[-0.1 m/s, 0.2 m/s]", "[-0.1, 0.2]"),
+     "lib.yaml:6:15: error: action 'crawl': 'linear_x': -0.1 needs a unit (m/s, cm/s or km/h)"),
+    (CRAWL + "    type: std_msgs/String\n",
+     "lib.yaml:8:11: error: action 'crawl': 'type' must be one of geometry_msgs/Twist, geometry_msgs/TwistStamped"),
+])
+def test_a_bad_limit_is_refused_before_the_monitor_subscribes_or_publishes(ros, tmp_path, lib, message):
+    out = refused(ros, limit_spec(tmp_path, lib))
+    assert message in out, out
+
+
+def refused(ros, spec, *params):
+    """Start a monitor on a spec it must refuse: it exits 1, or stays up enforcing nothing; either
+    way it says why, with no traceback, and never subscribes to the spec's topics nor publishes."""
+    proc = ros.spawn([PY, os.path.join(ROOT, "scripts", "monitor"), f"_spec:={spec}"] + list(params), "refused")
+    end = time.time() + 30
+    while proc.poll() is None and "NOT ENFORCING" not in ros.log(proc) and time.time() < end:
+        time.sleep(0.1)
+    out = ros.log(proc)
+    assert proc.returncode in (None, 1) and ("NOT ENFORCING" in out or "cannot start" in out), out
+    assert "Traceback" not in out
+    import rosgraph
+    state = rosgraph.Master("/t", master_uri=ros.env["ROS_MASTER_URI"]).getSystemState()
+    assert not [t for t, _ in state[1] if t in ("/trig", "/cmd_vel", "/a", "/b")], state
+    assert not [t for t, _ in state[0] if t == "/safety_cmd"], state
+    return out
