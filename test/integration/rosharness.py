@@ -20,9 +20,18 @@ class Ros:
         if not os.path.exists("/usr/bin/rosmaster"):
             pytest.skip("ROS 1 is not installed (rosmaster)")
         from rubass.ros.master import PrivateMaster
+        from rubass.ros.sim.procs import Supervisor
 
         self.tmp = tmp_path
-        self.master = PrivateMaster(str(tmp_path / "ros_home"))
+        # every process of the test carries its marker (self.env): if pytest is killed (SIGTERM from a
+        # CI timeout, SIGKILL) before stop(), the supervisor's reaper stops them (issue 19)
+        self.sup = Supervisor(signals=False).__enter__()
+        try:
+            self.master = PrivateMaster(str(tmp_path / "ros_home"))
+        except BaseException:
+            self.sup.__exit__(None, None, None)
+            raise
+        self.sup.adopt(self.master.process)
         self.port = self.master.port
         self.env = dict(self.master.env, ROS_LOG_DIR=str(tmp_path / "ros_log"), PYTHONUNBUFFERED="1")
         self.procs = []
@@ -79,8 +88,11 @@ class Ros:
     def stop(self):
         from rubass.ros.master import stop_processes
 
-        stop_processes(list(reversed(self.procs)))
-        self.master.stop()
+        try:
+            stop_processes(list(reversed(self.procs)))
+            self.master.stop()
+        finally:
+            self.sup.__exit__(None, None, None)
 
 
 LIB = """actions:

@@ -86,8 +86,8 @@ def test_children_die_with_a_sigkilled_parent(mark):
 def test_a_stop_signal_raises_interrupted_once_and_everything_is_stopped(mark, sig):
     child = _run_child("""
         a = sup.spawn(["sleep", "60"])
-        print(a.pid, flush=True)
         try:
+            print(a.pid, flush=True)
             time.sleep(60)
         except Interrupted as exc:
             os.kill(os.getpid(), exc.signum)  # a second signal during the cleanup: noted, not raised

@@ -15,6 +15,7 @@
 """
 from __future__ import annotations
 
+import atexit
 import contextlib
 import ctypes
 import os
@@ -55,11 +56,15 @@ class Interrupted(BaseException):
         return 128 + self.signum
 
 
-def _pdeathsig(sig: int, parent: int) -> Any:
+def die_with_parent(sig: int = signal.SIGTERM) -> Any:
+    """A `preexec_fn` for subprocess.Popen: the child gets `sig` when this process (precisely:
+    the thread calling Popen) dies. Call Popen from the main thread or a thread that lives on."""
+    parent = os.getpid()
+
     def preexec() -> None:  # in the child, between fork and exec
         if _prctl is not None:
             _prctl(_PR_SET_PDEATHSIG, int(sig), 0, 0, 0)
-        if os.getppid() != parent:  # the command died before prctl took effect
+        if os.getppid() != parent:  # the parent died before prctl took effect
             os._exit(1)
     return preexec
 
@@ -68,9 +73,12 @@ class Supervisor:
     """Starts, tracks and stops a command's processes; see the module docstring.
 
     Use as a context manager from the main thread: entering installs the signal handlers and
-    starts the reaper, leaving stops every process still running and restores the handlers."""
+    starts the reaper, leaving stops every process still running and restores the handlers.
+    `signals=False` leaves the signal handlers alone (a test harness under pytest): only the
+    marker, the reaper and PR_SET_PDEATHSIG."""
 
-    def __init__(self) -> None:
+    def __init__(self, signals: bool = True) -> None:
+        self.signals = signals
         self.marker = uuid.uuid4().hex
         self.signum: Optional[int] = None
         self._raised = False
@@ -84,15 +92,21 @@ class Supervisor:
     def __enter__(self) -> "Supervisor":
         if threading.current_thread() is not threading.main_thread():
             raise RuntimeError("a Supervisor is used from the main thread only")
-        for sig in SIGNALS:
-            old = signal.getsignal(sig)
-            if old is signal.SIG_IGN:
-                continue
-            self._old[sig] = old
-            signal.signal(sig, self._on_signal)
         self._old_marker = os.environ.get(MARKER)
-        os.environ[MARKER] = self.marker
-        self._start_reaper()
+        with self.deferred(raise_after=False):
+            for sig in SIGNALS if self.signals else ():
+                old = signal.getsignal(sig)
+                if old is signal.SIG_IGN:
+                    continue
+                self._old[sig] = old
+                signal.signal(sig, self._on_signal)
+            os.environ[MARKER] = self.marker
+            self._start_reaper()
+        try:
+            self.check()  # a signal that came meanwhile
+        except Interrupted:
+            self.__exit__(None, None, None)
+            raise
         return self
 
     def __exit__(self, *exc: Any) -> None:
@@ -147,7 +161,7 @@ class Supervisor:
             proc = subprocess.Popen(list(args), env=self.env(env), cwd=cwd,
                                     stdout=subprocess.DEVNULL if stdout is None else stdout,
                                     stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL, start_new_session=True,
-                                    preexec_fn=_pdeathsig(stop_signal, os.getpid()))
+                                    preexec_fn=die_with_parent(stop_signal))
             self.adopt(proc, stop_signal)
         return proc
 
@@ -208,6 +222,28 @@ class Supervisor:
             self._reaper.kill()
             self._reaper.wait()
         self._reaper = None
+
+
+def supervise_script(prog: str) -> Supervisor:
+    """For a script whose code knows nothing of Interrupted (a benchmark): a Supervisor for the
+    rest of the process. A stop signal unwinds the script's `finally` blocks (which stop its
+    processes), then it exits 128 + the signal with one line on stderr, no traceback; every
+    process still running (or started without `spawn`, with the marker) is stopped at exit."""
+    sup = Supervisor().__enter__()
+    atexit.register(sup.__exit__, None, None, None)
+    default_hook = sys.excepthook
+
+    def hook(kind: Any, value: BaseException, tb: Any) -> None:
+        if not isinstance(value, Interrupted):
+            default_hook(kind, value, tb)
+            return
+        print(f"{prog}: interrupted by {value.name}", file=sys.stderr)
+        with contextlib.suppress(Exception):
+            sys.stdout.flush()
+            sup.__exit__(None, None, None)
+        os._exit(value.exit_status)
+    sys.excepthook = hook
+    return sup
 
 
 def _killpg(pgid: int, sig: int) -> None:
