@@ -22,6 +22,7 @@ class Dispatcher:
         self.report = report
         self.ros_now = ros_now
         self.latencies: List[float] = []  # seconds, last 1000 starts
+        self.last_start = "none"  # the last start and why, for /diagnostics
         self.orphans: List[Any] = []  # (behaviour, key): latched, from a spec a reload replaced
         self._keys_for: Any = None
         self._keys: Dict[int, Any] = {}
@@ -81,6 +82,10 @@ class Dispatcher:
         witness = getattr(e, "witness", None)
         if witness is not None:  # why it started: name, attributes, true rules and the values they read
             record.update(witness.as_json())
+            why = "; ".join([f"true: {', '.join(witness.rules)}"] * bool(witness.rules)
+                            + [r.text() for r in witness.readings])
+            who = witness.name or f"behaviour {e.behaviour}"
+            self.last_start = f"{who} at {e.time:.3f} s" + (f": {why}" if why else "")
         self.report(record)
 
     def release(self, b: CheckedBehaviour, key: Any, now: float) -> None:

@@ -117,3 +117,16 @@ def test_replay_json_and_report_show_witnesses():
     report.human(e.spec, events, 1.0, text)
     assert "true: base.too_fast" in text.getvalue()
     assert "/odom.twist.twist.linear.x = 0.62" in text.getvalue()
+
+
+def test_monitor_events_and_diagnostics_carry_the_witness():
+    from rubass.ros.dispatch import Dispatcher
+
+    records = []
+    d = Dispatcher({}, records.append, lambda: 0.3)
+    e = engine()
+    d.handle(e, e.on_message("/odom", 0.3, odom(0.62)), "deadline")
+    (rec,) = records
+    assert rec["event"] == "start" and rec["witnesses"] == {"/odom.twist.twist.linear.x": 0.62}
+    assert rec["rules"] == ["base.too_fast"]
+    assert d.last_start == "behaviour 1 at 0.300 s: true: base.too_fast; /odom.twist.twist.linear.x = 0.62"
