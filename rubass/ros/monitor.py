@@ -47,6 +47,7 @@ from std_srvs.srv import Trigger, TriggerResponse
 from ..engine import Engine
 from ..engine.loop import EngineLoop, Message, NodeSample
 from ..lang import SpecError, load_spec
+from ..lang.library import priority_conflicts
 from ..lang.model import CheckedSpec
 from . import status as status_mod
 from .actions.base import ActionSetupError, make_plugin
@@ -108,6 +109,7 @@ class Monitor:
             raise StartupError(exc.render()) from None
         self._check_overload_actions(spec)
         self._check_library_types(spec)
+        self._check_priorities(spec)
         for w in spec.warnings:
             rospy.logwarn("rubass: %s", w.render(spec.sources))
         return spec, self._runners(spec, {})
@@ -124,6 +126,13 @@ class Monitor:
         errors, _ = after_check(spec, None)
         if errors:
             raise StartupError("\n".join(d.render(spec.sources) for d in errors))
+
+    @staticmethod
+    def _check_priorities(spec: CheckedSpec) -> None:
+        """Two actions of one priority on one topic (§16), across libraries, names resolved."""
+        conflicts = priority_conflicts(spec.actions.values(), rospy.resolve_name)
+        if conflicts:
+            raise StartupError("\n".join(d.render(spec.sources) for d in conflicts))
 
     def _runners(self, spec: CheckedSpec, keep: Dict[str, ActionRunner]) -> Dict[str, ActionRunner]:
         """Runners for the spec's actions, reusing those whose definition did not change."""
@@ -305,6 +314,7 @@ class Monitor:
                 spec = self._load_stable()
                 self._check_overload_actions(spec)
                 self._check_library_types(spec)
+                self._check_priorities(spec)
                 t_check = time.monotonic()
                 if self.spec is None:  # not enforcing yet: this spec is the first usable one
                     self._enforce(spec, self._runners(spec, {}))
