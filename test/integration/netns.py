@@ -3,13 +3,14 @@
 Each host is a namespace with `lo` and one interface `eth0` (a veth pair whose other end is
 on a bridge in a "switch" namespace), at 10.200.0.N/24. Those addresses exist only inside
 the namespaces made here, so no traffic leaves them. `cut(host)` takes the host's link down
-on the switch side (the cable pulled); `close()` deletes every namespace (and with them
-their veths). Namespace names carry this process's pid: leftovers of a killed test run are
+on the switch side (the cable pulled); `close()` stops what still runs in them and deletes
+every namespace (and with them their veths and the bridge). Namespace names carry this process's pid: leftovers of a killed test run are
 removed by the next run. Needs root and iproute2; `Network.check()` says why not.
 """
 import os
 import re
 import shutil
+import signal
 import subprocess
 from typing import Dict, List, Set
 
@@ -29,12 +30,22 @@ def _namespaces() -> List[str]:
     return [line.split()[0] for line in out.stdout.splitlines() if line.strip()]
 
 
+def _delete(ns: str) -> None:
+    """Stop what still runs in a namespace of ours (SIGKILL), then delete it."""
+    for pid in _ip("netns", "pids", ns, check=False).stdout.split():
+        try:
+            os.kill(int(pid), signal.SIGKILL)
+        except (ProcessLookupError, ValueError):
+            pass
+    _ip("netns", "del", ns, check=False)
+
+
 def remove_leftovers() -> None:
     """Delete namespaces left by test runs whose process is gone (killed before cleaning up)."""
     for ns in _namespaces():
         m = re.match(rf"{PREFIX}(\d+)_", ns)
         if m and not os.path.exists(f"/proc/{m.group(1)}"):
-            _ip("netns", "del", ns, check=False)
+            _delete(ns)
 
 
 class Network:
@@ -103,7 +114,7 @@ class Network:
     def close(self) -> None:
         """Delete every namespace made (their veths and the bridge go with them)."""
         for ns in reversed(self._made):
-            _ip("netns", "del", ns, check=False)
+            _delete(ns)
         self._made = []
 
     def leftovers(self) -> List[str]:
