@@ -12,6 +12,7 @@ Parameters (private)
                                   after a master restart: docs/monitor.md)
     ~overload_actions (list)      actions to run while the engine's queue drops messages (fail safe)
     ~queue_size (default 100000)  messages the engine's queue holds (and 256 MiB of message bytes)
+    ~error_actions (list)         actions to run while a field cannot be read as the spec needs (fail safe)
     ~state_file (string)          latched actions kept across the monitor's restarts (default
                                   $ROS_HOME/rubass/NODE.latches.json; false: off)
 Subscribes
@@ -47,7 +48,6 @@ from std_srvs.srv import Trigger, TriggerResponse
 from ..engine import Engine
 from ..engine.loop import EngineLoop, Message, NodeSample
 from ..lang import SpecError, load_spec
-from ..lang.library import priority_conflicts
 from ..lang.model import CheckedSpec
 from . import status as status_mod
 from .actions.base import ActionSetupError, make_plugin
@@ -61,6 +61,7 @@ from .nodes import NodeSampler
 from .outputs import Outputs
 from .overload import OverloadGuard
 from .clockjump import ClockJump
+from .errorguard import ErrorGuard
 from .keeper import LatchKeeper
 from .latches import LatchFile, default_path
 from .params import MonitorConfig, ParamError, read_config
@@ -109,7 +110,6 @@ class Monitor:
             raise StartupError(exc.render()) from None
         self._check_overload_actions(spec)
         self._check_library_types(spec)
-        self._check_priorities(spec)
         for w in spec.warnings:
             rospy.logwarn("rubass: %s", w.render(spec.sources))
         return spec, self._runners(spec, {})
@@ -119,6 +119,10 @@ class Monitor:
         if missing:
             raise ConfigError(f"{spec.path}: ~overload_actions names {', '.join(missing)}, which the spec does not "
                                f"declare (add 'action primitive {', '.join(missing)};')")
+        missing = [a for a in self.config.error_actions if a not in spec.actions]
+        if missing:
+            raise ConfigError(f"{spec.path}: ~error_actions names {', '.join(missing)}, which the spec does not "
+                              f"declare (add 'action primitive {', '.join(missing)};')")
 
     @staticmethod
     def _check_library_types(spec: CheckedSpec) -> None:
@@ -126,13 +130,6 @@ class Monitor:
         errors, _ = after_check(spec, None)
         if errors:
             raise StartupError("\n".join(d.render(spec.sources) for d in errors))
-
-    @staticmethod
-    def _check_priorities(spec: CheckedSpec) -> None:
-        """Two actions of one priority on one topic (§16), across libraries, names resolved."""
-        conflicts = priority_conflicts(spec.actions.values(), rospy.resolve_name)
-        if conflicts:
-            raise StartupError("\n".join(d.render(spec.sources) for d in conflicts))
 
     def _runners(self, spec: CheckedSpec, keep: Dict[str, ActionRunner]) -> Dict[str, ActionRunner]:
         """Runners for the spec's actions, reusing those whose definition did not change."""
@@ -160,6 +157,7 @@ class Monitor:
         self.dispatcher = Dispatcher({}, self.outputs.event, _ros_now)
         self.overload = OverloadGuard(self.config.overload_actions, 1.0, _log, self.outputs.event)
         self.keeper = LatchKeeper(LatchFile(self.config.state_file, self.config.spec), _log, self.outputs.event)
+        self.error_guard = ErrorGuard(self.config.error_actions, _log, self.outputs.event)
         self.clock_jump = ClockJump(self.dispatcher, _log,
                                     lambda engine: self.keeper.save(engine, self.dispatcher.orphans, self._fail_safes()))
         try:
@@ -197,8 +195,13 @@ class Monitor:
             self.keeper.save(engine, self.dispatcher.orphans, self._fail_safes())
         self.dispatcher.handle(engine, events, cause)
 
-    def _fail_safes(self, starting: bool = False) -> List[List[str]]:
-        return [self.overload.actions] if self.overload.active or starting else []
+    def _fail_safes(self, starting: bool = False, error_starting: bool = False) -> List[List[str]]:
+        out = [self.overload.actions] if self.overload.active or starting else []
+        return out + ([self.error_guard.actions] if self.error_guard.active or error_starting else [])
+
+    def _data_errors(self, engine: Engine) -> List[str]:
+        """Fields that cannot be read as the spec needs, now (on the engine's thread)."""
+        return self.watcher.data_errors() + [f"topic {t}: {m}" for (t, _), m in sorted(engine.field_errors.items())]
 
     def _enforce(self, spec: CheckedSpec, runners: Dict[str, ActionRunner]) -> None:
         """Start the actions, restore latches, wait for the clock, then the first evaluation."""
@@ -250,6 +253,15 @@ class Monitor:
         if was and not self.overload.active:
             self.keeper.save(loop.engine, self.dispatcher.orphans, self._fail_safes())
         self.clock_jump.check(loop.engine, now)
+        if self.error_guard.actions:
+            errors = self._data_errors(loop.engine)
+            was = self.error_guard.active
+            if errors and not was:  # written before the fail-safe runs
+                self.keeper.save(loop.engine, self.dispatcher.orphans, self._fail_safes(error_starting=True))
+            self.error_guard.check(errors, now, self.dispatcher.runners,
+                                   lambda name: loop.engine.spec.actions[name].latch)
+            if was and not self.error_guard.active:
+                self.keeper.save(loop.engine, self.dispatcher.orphans, self._fail_safes())
 
     def _sampler(self, spec: CheckedSpec) -> NodeSampler:
         nodes = [(n, rospy.resolve_name(n)) for n in sorted(spec.nodes)]
@@ -314,7 +326,6 @@ class Monitor:
                 spec = self._load_stable()
                 self._check_overload_actions(spec)
                 self._check_library_types(spec)
-                self._check_priorities(spec)
                 t_check = time.monotonic()
                 if self.spec is None:  # not enforcing yet: this spec is the first usable one
                     self._enforce(spec, self._runners(spec, {}))
@@ -404,6 +415,7 @@ class Monitor:
             self.dispatcher.release_orphans(now)
             n += self.overload.reset(now, self.dispatcher.runners)
             n += self.keeper.reset(self.dispatcher.runners, now)
+            n += self.error_guard.reset(now, self.dispatcher.runners)
             self.keeper.save(engine, self.dispatcher.orphans, self._fail_safes())
             return sum(e.kind == "release" for e in events) + n
 
@@ -426,6 +438,7 @@ class Monitor:
             return dict(engine.store.rules), engine.active_behaviours(), dict(engine.field_errors)
 
         rules, active, field_errors = loop.call(snapshot)
+        data_errors = loop.call(self._data_errors)
         topics = {s.spec_name: {"messages": s.messages, "errors": s.errors, "type": s.type}
                   for s in self.watcher.status()}
         nodes = {s.spec_name: {"why": s.why} for s in self.sampler.status.values()}
@@ -447,6 +460,9 @@ class Monitor:
                 monitor[f"action {name}"] = r.stats.last_error
         monitor.update(self.keeper.status())
         monitor["clock jumps back"] = loop.clock_jumps
+        monitor["data errors"] = "; ".join(data_errors) or "none"
+        if self.error_guard.active:
+            monitor["data error actions"] = "running " + ", ".join(self.error_guard.actions)
         assert self.spec is not None
         entries = status_mod.build(self.spec, rules, active, topics, nodes, field_errors, monitor)
         self.outputs.status(entries, _ros_now())
@@ -470,6 +486,8 @@ class Monitor:
                     self.dispatcher.release(b, keys[index], now)
             if not any(engine.spec.actions[a].latch for a in self.overload.actions):
                 self.overload.release(now, self.dispatcher.runners, "the monitor stops")
+            if not any(engine.spec.actions[a].latch for a in self.error_guard.actions):
+                self.error_guard.release(now, self.dispatcher.runners, "the monitor stops")
 
         rospy.loginfo("rubass: stopping: releasing non-latched actions")
         try:

@@ -30,8 +30,9 @@ def _message_class(type_name: str, near: Any) -> Optional[Any]:
         return None
 
 
-def check_path(cls: Any, path: Tuple[PathElem, ...]) -> Optional[str]:
-    """None if `path` can exist in messages of class `cls`, else what is wrong with it."""
+def check_path(cls: Any, path: Tuple[PathElem, ...], scalar: bool = False) -> Optional[str]:
+    """None if `path` can exist in messages of class `cls`, else what is wrong with it.
+    scalar: the spec uses the value as a number or truth value (not as min(), max(), len()'s argument)."""
     type_name = getattr(cls, "_type", cls.__name__)
     current: Optional[Any] = cls
     slot_type = type_name
@@ -62,4 +63,7 @@ def check_path(cls: Any, path: Tuple[PathElem, ...]) -> Optional[str]:
         current = None if base in _PRIMITIVES else _message_class(base, cls)
     if not _ARRAY.match(slot_type) and slot_type not in _PRIMITIVES:
         return f"'{done}' is a message ({slot_type}), not a value: name one of its fields"
+    if scalar and _ARRAY.match(slot_type):
+        return (f"'{done}' is an array ({slot_type}) used as a single value: take min(), max() or len() of it, "
+                f"or index it, e.g. '{done}[0]'")
     return None

@@ -26,6 +26,7 @@ class MonitorConfig:
     overload_actions: List[str] = field(default_factory=list)  # run while messages are dropped
     queue_size: int = 100000  # messages the engine's queue holds
     state_file: Optional[str] = None  # latched actions kept across restarts; None: off
+    error_actions: List[str] = field(default_factory=list)  # run while a field cannot be read
 
 
 def _rate(get: Getter, name: str, default: float, lo: float, hi: float) -> float:
@@ -72,6 +73,7 @@ def read_config(get: Getter, default_state_file: Optional[str] = None) -> Monito
         raise ParamError(f"~spec must be the path of a .rbs file, got {spec!r}")
     actions = _names(get, "actions", "action library paths")
     overload = _names(get, "overload_actions", "action names")
+    error_actions = _names(get, "error_actions", "action names")
     queue_size = get("queue_size", 100000)
     if not isinstance(queue_size, int) or isinstance(queue_size, bool) or not 10 <= queue_size <= 10_000_000:
         raise ParamError(f"~queue_size must be a whole number of messages from 10 to 10000000, got {queue_size!r}")
@@ -85,4 +87,5 @@ def read_config(get: Getter, default_state_file: Optional[str] = None) -> Monito
         overload_actions=overload,
         queue_size=queue_size,
         state_file=_state_file(get, default_state_file),
+        error_actions=error_actions,
     )

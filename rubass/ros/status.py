@@ -40,7 +40,7 @@ def unknown_reasons(spec: CheckedSpec, rule_key: str, topics: Dict[str, Dict[str
                 why.append(err)
             fe = field_errors.get((e.topic, str(e.path)))
             if fe:
-                why.append(f"{e.topic}: {fe}")
+                why.append(f"rule '{rule_key}' reads {e.topic}{ast.path_suffix(e.path)}: {fe}")
         elif isinstance(e, _NODE_REFS):
             n = nodes.get(e.node)
             if n is not None and n.get("why") not in (None, "alive"):
@@ -70,8 +70,9 @@ def build(spec: CheckedSpec, rules: Dict[str, Any], active: List[int], topics: D
                 if reasons:
                     values.append((f"{key.split('.', 1)[1]} unknown because", "; ".join(reasons)))
                 errors += [r for r in reasons if "reads" in r or "changed type" in r or "deserialise" in r]
-        if errors:
-            level, msg = ERROR, f"data errors: {len(set(errors))}"
+        if errors:  # named: the rule, the field and what is wrong
+            level, msg = ERROR, f"DATA ERROR: {sorted(set(errors))[0]}" + (
+                f" (and {len(set(errors)) - 1} more)" if len(set(errors)) > 1 else "")
         elif true_rules:
             level, msg = WARN, "violated: " + ", ".join(k.split(".", 1)[1] for k in true_rules)
         elif unknown:
@@ -87,6 +88,9 @@ def build(spec: CheckedSpec, rules: Dict[str, Any], active: List[int], topics: D
         msg_latch = f" (latch state: {monitor['latch state error']})"
     else:
         msg_latch = ""
+    if monitor.get("data errors", "none") != "none":  # a rule that cannot read its field protects nothing
+        level = ERROR
+        msg_latch += f" (DATA ERROR: {monitor['data errors']})"
     msg = f"enforcing {spec.path}: {len(spec.rules)} rules, {len(spec.behaviours)} behaviours"
     if monitor.get("overloaded", "no") != "no":
         level = ERROR

@@ -7,7 +7,7 @@ from __future__ import annotations
 import threading
 import time
 from dataclasses import dataclass, field
-from typing import Any, Callable, Dict, List, Optional, Tuple
+from typing import Any, Callable, Dict, FrozenSet, List, Optional, Set, Tuple
 
 import genpy
 import genpy.dynamic
@@ -31,6 +31,7 @@ class TopicState:
     resolved: str
     paths: Dict[Tuple[ast.PathElem, ...], List[str]]  # field path -> rules reading it
     aliases: Tuple[str, ...] = ()  # other spellings of this topic in the spec ('cmd_vel' beside '/cmd_vel')
+    scalar: FrozenSet[Tuple[ast.PathElem, ...]] = frozenset()  # paths the spec uses as one value
     type: str = ""
     md5: str = ""
     messages: int = 0
@@ -55,6 +56,7 @@ class TopicWatcher:
         for t in sorted(spec.topics, key=lambda t: (not spec.topics[t].paths, t)):  # a reader of fields first
             spellings.setdefault(rospy.resolve_name(t), []).append(t)
         wanted = {r: names[0] for r, names in spellings.items()}
+        scalar = scalar_paths(spec)
         readers = spec.field_readers()
         users: Dict[str, Dict[Tuple[ast.PathElem, ...], List[str]]] = {}
         for names in spellings.values():
@@ -71,13 +73,15 @@ class TopicWatcher:
             for resolved, name in wanted.items():
                 state = self.topics.get(resolved)
                 aliases = tuple(spellings[resolved][1:])
+                used_as_value = frozenset(p for n in spellings[resolved] for p in scalar.get(n, ()))
                 if state is None:
-                    state = TopicState(name, resolved, users[name], aliases)
+                    state = TopicState(name, resolved, users[name], aliases, used_as_value)
                     self.topics[resolved] = state
                     state.subscriber = rospy.Subscriber(resolved, rospy.AnyMsg, self._callback,
                                                         callback_args=state, tcp_nodelay=True)
                 else:
                     state.spec_name, state.paths, state.aliases = name, users[name], aliases
+                    state.scalar = used_as_value
                     if state.cls is not None:
                         state.errors = self._check(state)
 
@@ -112,6 +116,9 @@ class TopicWatcher:
                 state.errors.append(f"cannot deserialise a {state.type} message: {exc}")
                 self.log("error", f"topic {state.resolved}: {state.errors[-1]}")
             msg = UNKNOWN
+        else:
+            if state.errors and state.errors[-1].startswith("cannot deserialise"):
+                state.errors.pop()  # readable again: the error lasted until this message
         self.submit(state.spec_name, now, msg, wall, len(raw._buff) if msg is not UNKNOWN else 0)
         for alias in state.aliases:  # the same message, under the spec's other spelling of the topic
             self.submit(alias, now, msg, wall, 0)
@@ -132,7 +139,7 @@ class TopicWatcher:
     def _check(self, state: TopicState) -> List[str]:
         out = []
         for path, owners in state.paths.items():
-            problem = check_path(state.cls, path) if state.cls is not None else None
+            problem = check_path(state.cls, path, path in state.scalar) if state.cls is not None else None
             if problem:
                 out.append(f"{' and '.join(owners)} reads {state.spec_name}{ast.path_suffix(path)}, but in {state.type}: "
                            f"{problem}; its value stays unknown")
@@ -155,6 +162,30 @@ class TopicWatcher:
             self._classes[md5] = cls
         return cls
 
+    def data_errors(self) -> List[str]:
+        """What cannot be read as the spec needs now: a field missing or of the wrong kind, a
+        message that cannot be deserialised, a type that cannot be loaded (not a mere type change)."""
+        with self._lock:
+            return [f"topic {s.resolved}: {e}" for s in self.topics.values() for e in s.errors
+                    if not e.startswith("changed type")]
+
     def status(self) -> List[TopicState]:
         with self._lock:
             return list(self.topics.values())
+
+
+def scalar_paths(spec: CheckedSpec) -> Dict[str, Set[Tuple[ast.PathElem, ...]]]:
+    """topic -> the field paths the spec uses as one value (compared, computed with, a condition),
+    rather than as the argument of a function (min, max, len of an array)."""
+    out: Dict[str, Set[Tuple[ast.PathElem, ...]]] = {}
+    exprs = [r.expr for r in spec.rules] + [b.cond for b in spec.behaviours]
+    for expr in exprs:
+        if isinstance(expr, ast.TopicRef) and expr.path:
+            out.setdefault(expr.topic, set()).add(expr.path)
+        for e in ast.walk(expr):
+            if isinstance(e, ast.Call):
+                continue
+            for child in ast.children(e):
+                if isinstance(child, ast.TopicRef) and child.path:
+                    out.setdefault(child.topic, set()).add(child.path)
+    return out
