@@ -40,11 +40,16 @@ def bag_model(path: str) -> SystemModel:
     return SystemModel(dict(info.types), None, registry, source=f"the recording {os.path.basename(path)}")
 
 
-def _master(uri: Optional[str]):  # type: ignore[no-untyped-def]
+def _master(uri: Optional[str], timeout: float):  # type: ignore[no-untyped-def]
+    """A master handle whose every call gives up after `timeout` (a hung master must not hang us)."""
     import rosgraph
 
-    master = rosgraph.Master(CALLER, master_uri=uri)
-    if not rosgraph.is_master_online(master.master_uri):
+    try:
+        master = rosgraph.Master(CALLER, master_uri=uri)
+    except ValueError as exc:  # ROS_MASTER_URI unset or malformed
+        raise LiveError(f"{exc} (set ROS_MASTER_URI or pass --master http://HOST:11311)") from None
+    master.handle = rpc_proxy(master.master_uri, timeout)
+    if not master.is_online():
         raise LiveError(f"no ROS master at {master.master_uri} (is roscore running? is ROS_MASTER_URI right?)")
     return master
 
@@ -53,11 +58,11 @@ def live_model(uri: Optional[str] = None, timeout: float = 2.0) -> SystemModel:
     """Topics and types, nodes and definitions of the running graph."""
     import rosgraph.masterapi
 
-    master = _master(uri)
+    master = _master(uri, timeout)
     try:
         types = dict(master.getTopicTypes())
         pubs, subs, srvs = master.getSystemState()
-    except (rosgraph.masterapi.Error, OSError) as exc:
+    except (rosgraph.masterapi.Error, OSError) as exc:  # socket.timeout is an OSError
         raise LiveError(f"the master at {master.master_uri} does not answer: {exc}") from None
     nodes = sorted({n for _, ns in list(pubs) + list(subs) + list(srvs) for n in ns})
     registry = Registry()

@@ -145,3 +145,16 @@ def test_monitor_refuses_a_library_field_its_type_lacks_at_start_and_at_reload(r
     out = ros.call("/rubass/reload")
     assert "False" in out.stdout and "has no field 'dat'" in out.stdout, out.stdout
     assert mon.poll() is None
+
+
+def test_a_hung_master_is_an_error_not_a_hang(ros, write):
+    import signal
+
+    path = write("s.rbs", f'import "{LIB}";\naction primitive stop;\n'
+                          "entity e { rules: r: topic /x.data > 1; }\nif (e.r) then { stop; }\n")
+    os.kill(ros.master.process.pid, signal.SIGSTOP)
+    try:
+        code, _, err = rubass(ros, "check", "--live", path)  # the master's calls time out after 2 s
+    finally:
+        os.kill(ros.master.process.pid, signal.SIGCONT)
+    assert code == 2 and f"no ROS master at {ros.master.uri}" in err, err

@@ -196,6 +196,10 @@ def test_hand_written_model_file():
     ("topics: {}\ndefinitions:\n  a/B: |\n    float64 x y z\n", "robot.yaml:3:8", "the definition of a/B"),
     ("topics: {a: [\n", "robot.yaml:2:1", "invalid YAML"),
     ("topics: {}\nnodes: 3\n", "robot.yaml:2:8", "'nodes' must be a list"),
+    ("topics:\n  /a: !foo x\n", "robot.yaml:2:7", "YAML tag '!foo' is not allowed"),
+    ("topics: !!python/object:os.system {}\n", "robot.yaml:1:9", "is not allowed: a system model holds plain data"),
+    ("topics:\n  3: a/B\n", "robot.yaml:2:3", "'3' is not a topic name"),
+    ("\x00", "robot.yaml:1:1", "invalid YAML"),
 ])
 def test_model_file_errors_point_at_the_line(text, where, msg):
     m, diags = parse_model(Source("robot.yaml", text))
