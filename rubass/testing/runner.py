@@ -11,6 +11,7 @@ from dataclasses import dataclass, field
 from typing import Any, Dict, List, Optional, Set, Tuple
 
 from ..engine import Event
+from ..lang.ast import path_suffix
 from ..lang.errors import did_you_mean
 from ..lang.model import CheckedSpec
 from ..replay.run import replay
@@ -61,9 +62,14 @@ def _stream(spec: CheckedSpec, case: Case, path: str, warnings: List[str]) -> Li
                             f"{did_you_mean(topic, names)}; its messages change nothing")
             continue
         for fpath, owners in readers.get(names[topic], {}).items():
-            problem = check_path(t.cls, fpath)
+            plain = []
+            for p in fpath:  # up to a slice or [*] (§12): what lies beyond is per element
+                if not isinstance(p, (str, int)):
+                    break
+                plain.append(p)
+            problem = check_path(t.cls, tuple(plain))
             if problem:
-                text = "".join(f"[{p}]" if isinstance(p, int) else f".{p}" for p in fpath)
+                text = path_suffix(fpath)
                 raise TestFileError(path, t.line, f"{' and '.join(owners)} reads {topic}{text}, but in "
                                                   f"{t.type_name}: {problem}")
     groups: Dict[Tuple[float, str], List[MessageInput]] = {}

@@ -291,3 +291,43 @@ def test_more_bad_files(files, capsys, body, text):
 def test_a_test_without_expectations_passes(files, capsys):
     code, out, _ = run(capsys, files("  - name: inputs only\n    topics:\n" + ODOM))
     assert code == 0 and "PASS  inputs only" in out
+
+
+def test_version_2_escalation_within_and_sectors(write, capsys):
+    """active(), `within` and an array sector, through the test runner."""
+    write("lib.yaml", "actions:\n  stop: {plugin: log, level: warn}\n  board_stop: {plugin: log, level: error}\n")
+    write("esc.rbs", """import "lib.yaml";
+action primitive stop, board_stop;
+entity base { rules:
+  too_fast: topic /odom.twist.twist.linear.x > 0.5 m/s;
+  still_moving: abs(topic /odom.twist.twist.linear.x) > 0.05 m/s;
+  near: min(topic /scan.ranges[0:2]) < 0.4 m;
+}
+overspeed: if (base.too_fast) then { stop; }
+escalate: if ((active(stop) for 0.5 s) and base.still_moving) then { board_stop; }
+if (base.near within 1 s) then { stop; }
+""")
+    path = write("esc.test.yaml", """spec: esc.rbs
+tests:
+  - name: ladder
+    duration: 3 s
+    topics:
+      /odom: {type: nav_msgs/Odometry, rate: 10 Hz, field: twist.twist.linear.x, values: "0x5 0.6x5 0.3x10 0x10"}
+      /scan:
+        type: sensor_msgs/LaserScan
+        messages:
+          - {at: 0 s, ranges: [1, 1, 1], range_min: 0.1, range_max: 10}
+          - {at: 0.2 s, ranges: [1, 0.3, 0.2], range_min: 0.1, range_max: 10}
+          - {at: 0.3 s, ranges: [1, 1, 0.2], range_min: 0.1, range_max: 10}  # 0.2 m is outside [0:2]
+    expect:
+      - {at: 0.5 s, start: overspeed}
+      - {at: 1.0 s, release: overspeed}
+      - {at: 0.2 s, start: 3}
+      - {at: 1.3 s, release: 3}              # near until 0.3 s, within 1 s
+      - {at: 0.2 s, start: stop}
+      - {at: 1.3 s, release: stop}
+      - {at: 0.7 s, start: escalate}         # stop active for 0.5 s while moving
+      - {at: 1.3 s, release: escalate}
+""")
+    code, out, err = run(capsys, path)
+    assert code == 0, out + err
