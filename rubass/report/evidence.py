@@ -167,11 +167,21 @@ def replay_bag(spec: CheckedSpec, path: str, rate: float = 50.0) -> BagRun:
         present = [t for t in names if t in info.types]
         run.warnings = [f"topic {t} is not in the recording; its values stay unknown" for t in sorted(names)
                         if t not in info.types]
-        node_topics = sorted(t for t, ty in info.types.items() if t.endswith("/node_samples") and ty == "std_msgs/String")
-        node_topics = node_topics if spec.nodes else []
-        decode = {t for t in present if spec.topics[names[t]].needs_data} | set(node_topics)
-        stream = ((t, names.get(topic, topic), msg) for t, topic, msg in read(bag, present + node_topics, decode))
+        strings = [t for t, ty in info.types.items() if ty == "std_msgs/String"] if spec.nodes else []
+        node_topics = sorted(t for t in strings if t.endswith("/node_samples"))
+        agent_topics = sorted(t for t in strings if t.endswith("/agent_samples"))
+        decode = {t for t in present if spec.topics[names[t]].needs_data} | set(node_topics) | set(agent_topics)
+        stream: Any = ((t, names.get(topic, topic), msg)
+                       for t, topic, msg in read(bag, present + node_topics + agent_topics, decode))
         try:
+            if agent_topics:  # multi-host: the agents' reports, as `rubass replay` reads them
+                from ..replay.agents import SAMPLES, agent_samples
+                from ..replay.command import _sampled_nodes
+
+                skip = _sampled_nodes(read(bag, node_topics, set(node_topics)))
+                nodes = {(n if n.startswith("/") else "/" + n): n for n in spec.nodes}
+                stream = agent_samples(stream, set(agent_topics), nodes, skip, info.end)
+                node_topics = node_topics + [SAMPLES]
             _, run.events = replay(spec, stream, info.start, info.end, rate, node_topics)
         except BagError as exc:
             run.error = str(exc)
