@@ -13,7 +13,7 @@ from .arrays import array_fn, element, quantifier
 from .operators import ForOp, LatchOp, WithinOp
 from .store import Store
 from .timeflow import crossings
-from .values import UNKNOWN, as_bool, as_num
+from .values import UNKNOWN, as_bool, as_num, k_and, k_or
 
 Fn = Callable[[], Any]
 
@@ -70,6 +70,17 @@ class Compiler:
         if isinstance(e, ast.Unary):
             inner, op1 = self._fn(e.operand, ops, cell), UNARY[e.op]
             return lambda: op1(inner())
+        if isinstance(e, ast.Binary) and e.op in ("and", "or") and isinstance(e.left, ast.Binary) \
+                and e.left.op == e.op:
+            terms = tuple(self._fn(t, ops, cell) for t in ast.chain(e, e.op))
+            join = k_and if e.op == "and" else k_or
+
+            def chain() -> Any:  # every term, always: their operators see every evaluation
+                acc = as_bool(terms[0]())
+                for t in terms[1:]:
+                    acc = join(acc, as_bool(t()))
+                return acc
+            return chain
         if isinstance(e, ast.Binary):
             left, right, op2 = self._fn(e.left, ops, cell), self._fn(e.right, ops, cell), BINARY[e.op]
             return lambda: op2(left(), right())  # both sides always: their operators see every evaluation

@@ -6,7 +6,7 @@ wherever their layout differs.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Iterator, Optional, Tuple, Union
+from typing import Iterator, List, Optional, Tuple, Union
 
 from .source import NO_SPAN, Span
 
@@ -347,6 +347,18 @@ class Spec:
     decls: Tuple[Decl, ...]
     comments: Tuple[Comment, ...] = field(default=(), compare=False)
     file: str = field(default="<string>", compare=False)
+
+
+def chain(expr: Expr, op: str) -> List[Expr]:
+    """The terms of a left-deep chain `a op b op c …` in order (one term when expr is not one)."""
+    terms: List[Expr] = []
+    node = expr
+    while isinstance(node, Binary) and node.op == op:
+        terms.append(node.right)
+        node = node.left
+    terms.append(node)
+    terms.reverse()
+    return terms
 
 
 def walk(expr: Expr) -> Iterator[Expr]:

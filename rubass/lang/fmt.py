@@ -77,6 +77,10 @@ def _expr(e: ast.Expr, arr: Optional[ast.TopicRef] = None) -> str:
         if e.op == "not":
             return f"not {f(e.operand, 4)}"
         return f"-{f(e.operand, 8)}"
+    if isinstance(e, ast.Binary) and e.op in ("and", "or"):
+        p = _PREC[e.op]
+        terms = ast.chain(e, e.op)  # iteratively: a generated chain may have hundreds of terms
+        return f" {e.op} ".join([f(terms[0], p)] + [f(t, p + 1) for t in terms[1:]])
     if isinstance(e, ast.Binary):
         p = _PREC[e.op]
         left_need = p + 1 if p == 5 else p

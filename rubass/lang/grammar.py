@@ -402,10 +402,30 @@ def parse_source(source: Source) -> ast.Spec:
                 msg = f"expected {msg[len('Expected '):]}, found {_found(text, exc.loc)}"
             raise _error(source, exc.loc, msg) from None
         except RecursionError:
-            raise _error(source, 0, "expressions are nested too deeply to parse") from None
+            loc, depth = _deepest(text)
+            raise _error(source, loc, f"expressions are nested too deeply to parse ({depth} parentheses "
+                                      f"deep here; at most about {MAX_NESTING} are supported)") from None
         finally:
             _ctx.source = None
     return ast.Spec(tuple(toks), tuple(comments), file=source.name)
+
+
+MAX_NESTING = 40  # parentheses inside one expression that pyparsing parses within Python's stack
+
+
+def _deepest(text: str) -> Tuple[int, int]:
+    """The offset of the '(' where nesting is deepest, and that depth (strings skipped)."""
+    depth = best = 0
+    where = 0
+    for m in re.finditer(r'"(?:[^"\\\n]|\\.)*"|[()]', text):
+        tok = m.group(0)
+        if tok == "(":
+            depth += 1
+            if depth > best:
+                best, where = depth, m.start()
+        elif tok == ")":
+            depth = max(0, depth - 1)
+    return where, best
 
 
 def _error(source: Source, loc: int, msg: str) -> SpecError:

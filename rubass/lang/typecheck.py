@@ -185,10 +185,29 @@ class ExprChecker(BuiltinChecks):
         self._want_num(ty, e.operand.span, "'-'")
         return _fold(replace(e, operand=operand)), ty
 
+    def _chain(self, e: ast.Binary) -> Tuple[ast.Expr, Ty]:
+        """A long and/or chain, term by term (a generated spec may have hundreds of terms)."""
+        spans = []
+        node: ast.Expr = e
+        while isinstance(node, ast.Binary) and node.op == e.op:
+            spans.append(node.span)
+            node = node.left
+        spans.reverse()
+        terms = ast.chain(e, e.op)
+        out, ty = self.check(terms[0])
+        self._want_bool(ty, terms[0].span, f"'{e.op}'")
+        for term, span in zip(terms[1:], spans):
+            right, rt = self.check(term)
+            self._want_bool(rt, term.span, f"'{e.op}'")
+            out = _fold(ast.Binary(e.op, out, right, span=span))
+        return out, BOOL
+
     def _within(self, e: ast.Within) -> Tuple[ast.Expr, Ty]:
         return self._postfix(e, "within")
 
     def _binary(self, e: ast.Binary) -> Tuple[ast.Expr, Ty]:
+        if e.op in ("and", "or") and isinstance(e.left, ast.Binary) and e.left.op == e.op:
+            return self._chain(e)
         left, lt = self.check(e.left)
         right, rt = self.check(e.right)
         out = replace(e, left=left, right=right)

@@ -168,3 +168,19 @@ def test_folding_means_what_evaluation_means(tmp_path, expr, want):
     value = engine.rule_value("e.r")
     assert (None if value is not True and value is not False else value) == want
     assert [e for e in events if e.kind == "start"] == ([] if want is not True else events[-1:])
+
+
+def test_a_flat_chain_of_any_length_checks_formats_and_evaluates(tmp_path):  # issue 20.5
+    terms = " or ".join(f"topic /a.b > {i}" for i in range(500))
+    spec = ok(tmp_path, HEAD + f"entity e {{ rules: r: {terms}; }}\nif (e.r) then {{ stop; }}\n")
+    engine = Engine(spec, 0.0)
+    engine.evaluate_all(0.0)
+    assert [e.kind for e in engine.on_message("/a", 1.0, {"b": 499.5}) if e.kind == "start"] == ["start"]
+    text = format_spec(parse_text(HEAD + f"entity e {{ rules: r: {terms}; }}\n"))
+    assert text.count(" or ") + text.count("\n      or ") >= 499
+
+
+def test_deep_nesting_is_reported_at_the_expression(tmp_path):  # issue 20.5
+    deep = "(" * 60 + "topic /a.b > 1" + ")" * 60
+    got = errors(tmp_path, HEAD + f"entity e {{\n  rules: r: {deep};\n}}\nif (e.r) then {{ stop; }}\n")
+    assert got[0][0] == 4 and got[0][1] > 10 and "nested too deeply" in got[0][2], got
