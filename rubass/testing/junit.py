@@ -34,6 +34,7 @@ def write_junit(results: List[FileResult], path: str) -> None:
         suite.set("tests", str(len(r.outcomes) + (1 if r.error else 0)))
         suite.set("failures", str(n_fail))
         suite.set("errors", "1" if r.error else "0")
+        suite.set("time", f"{sum(o.elapsed for o in r.outcomes):.6f}")
         total += len(r.outcomes) + (1 if r.error else 0)
         failures += n_fail
         errors += 1 if r.error else 0
