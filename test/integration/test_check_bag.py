@@ -140,3 +140,16 @@ def test_model_file_units_of_custom_fields(write, tmp_path):
     assert code == 1
     assert f"{bad}:5:32: error: compares a voltage with a current" in err
     assert f"{bad}:5:58: error: compares a temperature with a time" in err
+
+
+def test_the_worked_example_of_docs_model_md():
+    """docs/model.md prints what `rubass check --bag` says of docs/examples/model/safety.rbs."""
+    import re
+
+    bag = shared_path("data", "turtlebot3_sim.bag")
+    folder = os.path.join(ROOT, "docs", "examples", "model")
+    code, _, err = rubass("check", "--bag", bag, os.path.join(folder, "safety.rbs"))
+    doc = open(os.path.join(ROOT, "docs", "model.md"), encoding="utf-8").read()
+    printed = re.search(r"\$ rubass check --bag turtlebot3_sim.bag safety.rbs\n(.*?)```", doc, re.S).group(1)
+    assert code == 1
+    assert err.replace(folder + os.sep, "") == printed
