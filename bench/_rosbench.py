@@ -2,9 +2,15 @@
 import json
 import os
 import subprocess
+import sys
 
 import _common
 from rubass.ros.master import PrivateMaster, stop_processes, wait_for_service
+from rubass.ros.sim.procs import supervise_script
+
+# a benchmark is a command that starts processes: SIGINT/SIGTERM/SIGHUP run its `finally` blocks and
+# exit 128+n, and whatever it started dies with it even when it is SIGKILLed (issue 19)
+supervise_script(os.path.basename(sys.argv[0]) or "bench")
 
 __all__ = ["PEER", "PY", "LIB", "PrivateMaster", "stop_processes", "spec_text", "start_monitor", "start_load", "run_peer"]
 
