@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 
+import os
 from dataclasses import dataclass, field
 from typing import Any, Dict, List, Optional, Sequence, Set
 
@@ -60,7 +61,11 @@ class Evidence:
 
     @property
     def outcomes(self) -> List[Outcome]:
-        return [o for r in self.results for o in r.outcomes]
+        """The outcomes of the tests of this spec (a file testing another spec is not evidence for it)."""
+        return [o for r in self.results if self.same_spec(r) for o in r.outcomes]
+
+    def same_spec(self, r: FileResult) -> bool:
+        return r.spec is not None and os.path.realpath(r.spec.path) == os.path.realpath(self.spec.path)
 
 
 def read_hazards(path: str) -> List[Hazard]:

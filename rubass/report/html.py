@@ -157,6 +157,9 @@ def _tests(ev: Evidence) -> str:
         if r.error:
             parts.append(f"<pre class='fail'>{_e(r.error)}</pre>")
             continue
+        if not ev.same_spec(r):
+            parts.append(f"<p class='fail'>These tests are of {_e(r.spec_path)}, not of this spec: they are not "
+                         f"counted as evidence for it.</p>")
         rows = []
         for o in r.outcomes:
             verdict = "<span class='pass'>PASS</span>" if o.passed else "<span class='fail'>FAIL</span>"
