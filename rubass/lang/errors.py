@@ -2,7 +2,7 @@
 from __future__ import annotations
 
 import difflib
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Iterable, List, Optional, Sequence
 
 from .source import Span, SourceSet
@@ -15,6 +15,8 @@ class Diagnostic:
     span: Span
     message: str
     severity: str = "error"
+    # the source line, for a file that could not be read as text (so it is in no SourceSet)
+    line_text: str = field(default="", compare=False)
 
     def render(self, sources: Optional[SourceSet] = None) -> str:
         """Compiler-style text: header, the source line, a caret under the column."""
@@ -22,9 +24,9 @@ class Diagnostic:
             return f"{self.span.file}: {self.severity}: {self.message}"
         head = f"{self.span}: {self.severity}: {self.message}"
         src = sources.get(self.span.file) if sources else None
-        if src is None:
+        if src is None and not self.line_text:
             return head
-        line = src.line_text(self.span.line)
+        line = src.line_text(self.span.line) if src is not None else self.line_text
         if len(line) > 200:
             lo = max(0, self.span.col - 100)
             line, col = line[lo:lo + 200], self.span.col - lo

@@ -45,10 +45,18 @@ def decode_source(name: str, data: bytes, what: str = "spec") -> Tuple[Optional[
         good = Source(name, data[: exc.start].decode("utf-8"))
         line, col = good.position(len(good.text))
         return None, Diagnostic(Span(name, line, col), f"{what} is not UTF-8 text: invalid byte "
-                                                       f"0x{data[exc.start]:02x}")
+                                                       f"0x{data[exc.start]:02x}", line_text=_shown_line(data, line))
     nul = text.find("\x00")
     if nul >= 0:
         src = Source(name, text)
         line, col = src.position(nul)
-        return None, Diagnostic(Span(name, line, col), f"{what} is not text: it contains a NUL byte")
+        return None, Diagnostic(Span(name, line, col), f"{what} is not text: it contains a NUL byte",
+                                line_text=_shown_line(data, line))
     return Source(name, text.replace("\r\n", "\n")), None
+
+
+def _shown_line(data: bytes, line: int) -> str:
+    """Line `line` (1-based) of undecodable bytes, shown with one mark per bad byte or NUL, so the
+    caret under the column points at it."""
+    raw = data.split(b"\n")[line - 1] if line - 1 < data.count(b"\n") + 1 else b""
+    return raw.decode("utf-8", errors="replace").replace("\x00", "\u2400")

@@ -184,3 +184,15 @@ def test_deep_nesting_is_reported_at_the_expression(tmp_path):  # issue 20.5
     deep = "(" * 60 + "topic /a.b > 1" + ")" * 60
     got = errors(tmp_path, HEAD + f"entity e {{\n  rules: r: {deep};\n}}\nif (e.r) then {{ stop; }}\n")
     assert got[0][0] == 4 and got[0][1] > 10 and "nested too deeply" in got[0][2], got
+
+
+@pytest.mark.parametrize("data,col,mark", [(b"entity e { rules: r: topic /a.b > 1; } // caf\xe9\n", 45, "\ufffd"),
+                                          (b"entity e { rules: r: topic /a.b\x00 > 1; }\n", 32, "\u2400")])
+def test_unreadable_bytes_are_shown_with_their_line_and_caret(tmp_path, data, col, mark):  # issue 20.7
+    path = tmp_path / "s.rbs"
+    path.write_bytes(data)
+    with pytest.raises(SpecError) as info:
+        load_spec(str(path))
+    text = str(info.value).splitlines()
+    assert text[0].startswith(f"{path}:1:{col}: error:")
+    assert mark in text[1] and text[2].index("^") == text[1].index(mark)
