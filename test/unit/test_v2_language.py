@@ -186,7 +186,7 @@ def test_deep_nesting_is_reported_at_the_expression(tmp_path):  # issue 20.5
     assert got[0][0] == 4 and got[0][1] > 10 and "nested too deeply" in got[0][2], got
 
 
-@pytest.mark.parametrize("data,col,mark", [(b"entity e { rules: r: topic /a.b > 1; } // caf\xe9\n", 45, "\ufffd"),
+@pytest.mark.parametrize("data,col,mark", [(b"entity e { rules: r: topic /a.b > 1; } // caf\xe9\n", 46, "\ufffd"),
                                           (b"entity e { rules: r: topic /a.b\x00 > 1; }\n", 32, "\u2400")])
 def test_unreadable_bytes_are_shown_with_their_line_and_caret(tmp_path, data, col, mark):  # issue 20.7
     path = tmp_path / "s.rbs"
