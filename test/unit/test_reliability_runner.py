@@ -130,3 +130,31 @@ def test_a_runner_that_replaces_another_carries_its_active_behaviours():
     finally:
         a.stop()
         b.stop()
+
+
+def test_a_bug_in_the_runner_itself_is_logged_and_the_action_goes_on():
+    p = AlwaysFails()
+    p.fail = False
+    logs = []
+    r = ActionRunner(p, lambda level, text: logs.append(text))
+    calls = {"n": 0}
+    real = r._do
+
+    def flaky(kind, ctx):
+        calls["n"] += 1
+        if calls["n"] == 1:
+            raise RuntimeError("a bug")
+        real(kind, ctx)
+
+    r._do = flaky
+    r.start_thread()
+    try:
+        r.submit("start", Context(1, 3, (), ("a",)))
+        r.submit("release", Context(1, 3, (), ("a",)))
+        end = time.monotonic() + 2
+        while not p.calls and time.monotonic() < end:
+            time.sleep(0.005)
+        assert p.calls == [("release", ("a",))], "the start was lost to the bug, the runner went on"
+        assert any("its runner failed" in t for t in logs) and r.stats.failures == 1
+    finally:
+        r.stop()

@@ -124,6 +124,18 @@ class ActionRunner:
 
     # -- the runner's thread -------------------------------------------------------------
     def _run(self) -> None:
+        while True:
+            try:
+                self._loop()
+                return
+            except Exception as exc:  # a bug in the runner itself must not end the action silently
+                self.stats.failures += 1
+                self.stats.last_error = f"runner: {exc.__class__.__name__}: {exc}"
+                self.log("error", f"action '{self.plugin.name}': its runner failed ({exc.__class__.__name__}: "
+                                  f"{exc}); going on")
+                time.sleep(0.05)
+
+    def _loop(self) -> None:
         if self.plugin.period:
             self._next_periodic = time.monotonic() + self.plugin.period
         while True:
