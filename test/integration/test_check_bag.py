@@ -109,7 +109,9 @@ def test_check_bag_field_errors_at_the_spec_line(write):
                        "    arr: topic /scan.ranges > 1 m;\n"
                        "    name: topic /odom.header.frame_id > 2;\n"
                        "    msg: topic /odom.pose.pose > 2;\n"
-                       "    ok: topic /cmd_vel.linear.x > 0.5 and min(topic /scan.ranges) < 30 cm;\n")
+                       "    ok: topic /cmd_vel.linear.x > 0.5 and min(topic /scan.ranges) < 30 cm;\n"
+                       "    sub: topic /scan.angle_min.x > 0;\n"
+                       "    eq: topic /odom.header.frame_id == 2 or topic /odom.header.frame_id == \"odom\";\n")
     code, _, err = rubass("check", "--bag", bag, path)
     assert code == 1
     assert f"{path}:5:32: error: compares a speed with a time" in err
@@ -119,7 +121,9 @@ def test_check_bag_field_errors_at_the_spec_line(write):
     assert f"{path}:8:11: error: '>' needs a number, not a string" in err
     assert f"{path}:9:10: error: 'topic /odom.pose.pose' is a message, not a value: it is a geometry_msgs/Pose" in err
     assert "        typo: topic /odom.twist.linear.x > 1 m/s;\n              ^" in err  # the line and a caret
-    assert f"{path}: 5 errors" in err  # line 10 is right: a bare 0.5 adopts m/s, 30 cm fits ranges
+    assert f"{path}:11:10: error: 'angle_min' is a float32, not a message: it has no field 'x'" in err
+    assert f"{path}:12:37: error: '==' compares a string with a number" in err
+    assert f"{path}: 7 errors" in err  # line 10 is right: a bare 0.5 adopts m/s, 30 cm fits ranges
 
 
 def test_the_same_spec_without_a_model_is_accepted(write):
