@@ -7,6 +7,7 @@ geometry_msgs/Pose says so. Fields absent here have no known dimension.
 """
 from __future__ import annotations
 
+import xml.etree.ElementTree as ElementTree
 from typing import Dict
 
 from .units import (CURRENT, DIMENSIONLESS, GEO_DEGREE, LENGTH, PRESSURE, SPEED, TEMPERATURE,
@@ -57,3 +58,14 @@ def joint_state_units(kinds: Dict[str, str]) -> Dict[str, Dimension]:
     if not kinds or len(found) != 1 or None in found:
         return {}
     return dict(JOINT_UNITS[next(iter(kinds.values()))])
+
+
+def urdf_joint_kinds(text: str) -> Dict[str, str]:
+    """URDF joint name -> joint type (fixed joints left out); ValueError for text that is not a URDF."""
+    try:
+        root = ElementTree.fromstring(text)
+    except ElementTree.ParseError as exc:
+        raise ValueError(f"not valid XML: {exc}") from None
+    if root.tag != "robot":
+        raise ValueError(f"not a URDF: the top element is <{root.tag}>, not <robot>")
+    return {j.get("name", ""): j.get("type", "") for j in root.iter("joint") if j.get("type") != "fixed"}

@@ -10,10 +10,11 @@ from typing import Optional, Tuple
 
 from ..lang.modelfile import dump_model, load_model
 from ..lang.source import SourceSet
+from ..lang.std_units import urdf_joint_kinds
 from ..lang.sysmodel import SystemModel
 from .bag import BagError
 from .libtypes import try_installed
-from .model_sources import LiveError, bag_model, live_model
+from .model_sources import LiveError, apply_joint_kinds, bag_model, live_model
 
 
 def add_source_options(parser: argparse.ArgumentParser, for_check: bool) -> None:
@@ -24,11 +25,28 @@ def add_source_options(parser: argparse.ArgumentParser, for_check: bool) -> None
     if for_check:
         g.add_argument("--model", metavar="ROBOT.yaml", help="a system model file written by 'rubass model'")
     parser.add_argument("--master", metavar="URI", help="the master for --live (default: ROS_MASTER_URI)")
+    parser.add_argument("--urdf", metavar="ROBOT.urdf", help="the robot's URDF: units of JointState fields by "
+                                                              "joint kind (--live reads /robot_description)")
 
 
 def build_model(args: argparse.Namespace) -> Tuple[Optional[SystemModel], int]:
     """The model the options name (None when none), or an exit status when it cannot be had;
     problems are printed."""
+    model, status = _build_model(args)
+    urdf = getattr(args, "urdf", None)
+    if model is None or not urdf:
+        return model, status
+    try:
+        with open(urdf, encoding="utf-8") as fh:
+            kinds = urdf_joint_kinds(fh.read())
+    except (OSError, UnicodeDecodeError, ValueError) as exc:
+        print(f"rubass: error: {urdf}: {getattr(exc, 'strerror', None) or exc}", file=sys.stderr)
+        return None, 2
+    apply_joint_kinds(model, kinds)
+    return model, 0
+
+
+def _build_model(args: argparse.Namespace) -> Tuple[Optional[SystemModel], int]:
     try:
         if getattr(args, "bag", None):
             return bag_model(args.bag), 0

@@ -6,11 +6,10 @@ from __future__ import annotations
 import io
 import os
 import socket
-import xml.etree.ElementTree as ElementTree
 from typing import Dict, Optional
 
 from ..lang.msgdef import DefinitionError, Registry
-from ..lang.std_units import joint_state_units
+from ..lang.std_units import joint_state_units, urdf_joint_kinds
 from ..lang.sysmodel import SystemModel
 from .bag import BagError, open_bag
 from .libtypes import add_installed
@@ -83,11 +82,7 @@ def live_model(uri: Optional[str] = None, timeout: float = 2.0) -> SystemModel:
     model = SystemModel({t: ty for t, ty in types.items() if ty != "*"}, nodes, registry,
                         source=f"the live graph at {master.master_uri}",
                         unpublished={t for t in types if t not in published})
-    kinds = _joint_kinds(master)
-    units = joint_state_units(kinds) if kinds else {}
-    for topic, ty in model.topics.items():
-        if ty == "sensor_msgs/JointState" and units:
-            model.topic_units[topic] = units
+    apply_joint_kinds(model, _joint_kinds(master))
     return model
 
 
@@ -111,8 +106,14 @@ def _definition_from_publisher(master, topic: str, node: str, timeout: float) ->
 def _joint_kinds(master) -> Dict[str, str]:  # type: ignore[no-untyped-def]
     """URDF joint name -> type from /robot_description; {} when absent or unreadable."""
     try:
-        text = master.getParam("/robot_description")
-        root = ElementTree.fromstring(text)
-    except Exception:
+        return urdf_joint_kinds(master.getParam("/robot_description"))
+    except Exception:  # no such parameter, not a URDF, a master gone: units stay unknown
         return {}
-    return {j.get("name", ""): j.get("type", "") for j in root.iter("joint") if j.get("type") != "fixed"}
+
+
+def apply_joint_kinds(model: SystemModel, kinds: Dict[str, str]) -> None:
+    """Units of every sensor_msgs/JointState topic of the model, when the joints' kinds say them."""
+    units = joint_state_units(kinds) if kinds else {}
+    for topic, ty in model.topics.items():
+        if ty == "sensor_msgs/JointState" and units:
+            model.topic_units[topic] = dict(units)

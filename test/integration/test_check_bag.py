@@ -157,3 +157,18 @@ def test_the_worked_example_of_docs_model_md():
     printed = re.search(r"\$ rubass check --bag turtlebot3_sim.bag safety.rbs\n(.*?)```", doc, re.S).group(1)
     assert code == 1
     assert err.replace(folder + os.sep, "") == printed
+
+
+def test_urdf_gives_joint_state_units(write):
+    bag = shared_path("data", "turtlebot3_sim.bag")
+    urdf = write("r.urdf", '<robot name="tb3"><link name="b"/><link name="l"/><link name="r"/>'
+                           '<joint name="wheel_left_joint" type="continuous"><parent link="b"/><child link="l"/></joint>'
+                           '<joint name="wheel_right_joint" type="continuous"><parent link="b"/><child link="r"/>'
+                           '</joint></robot>')
+    path = spec(write, "    r: abs(topic /joint_states.velocity[0]) > 3 m/s;\n")
+    code, _, err = rubass("check", "--bag", bag, path)
+    assert code == 0, err  # joint kinds unknown: no dimension
+    code, _, err = rubass("check", "--bag", bag, "--urdf", urdf, path)
+    assert code == 1 and f"{path}:5:45: error: compares a" in err and "angular speed with a speed" in err, err
+    code, _, err = rubass("check", "--bag", bag, "--urdf", path, path)
+    assert code == 2 and "not valid XML" in err

@@ -251,3 +251,15 @@ def test_a_topic_nobody_publishes_is_a_warning():
     warnings = graph_warnings(spec, model(unpublished={"scan"}))
     assert [f"{d.span}: {d.message}" for d in warnings] == [
         "s.rbs:4:11: topic '/scan' has no publisher in the system model (only subscribers): its data would never come"]
+
+
+def test_urdf_joint_kinds():
+    from rubass.lang.std_units import urdf_joint_kinds
+
+    text = '<robot name="r"><joint name="a" type="continuous"/><joint name="m" type="fixed"/>' \
+           '<joint name="lift" type="prismatic"/></robot>'
+    assert urdf_joint_kinds(text) == {"a": "continuous", "lift": "prismatic"}
+    with pytest.raises(ValueError, match="not a URDF"):
+        urdf_joint_kinds("<sdf/>")
+    with pytest.raises(ValueError, match="not valid XML"):
+        urdf_joint_kinds("<robot")
