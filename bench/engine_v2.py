@@ -5,6 +5,8 @@
     sector, a zone, active()) at 10, 100 and 1,000 rules: target <= 10 us and flat;
 (b) a 1,081-beam LaserScan (with inf and NaN) watched by three sector rules: target <= 50 us;
 (c) parse + check of 1,000 v2 rules: target < 1 s.
+Targets are met on CPU time (time.process_time), which other load on the machine barely
+changes; wall-clock p50/p99 per message are printed too.
 Usage: bench/engine_v2.py [--messages N] [--scans N] [--rules N] [--repeat K]
 """
 import argparse
@@ -134,6 +136,29 @@ def spec_text(n_rules: int) -> str:
     return "\n".join(lines) + "\n"
 
 
+def _cpu_us(make_engine, items) -> float:
+    """CPU time of the engine per item, on a fresh engine (process time: robust to other load)."""
+    engine = make_engine()
+    cpu = time.process_time
+    t0 = cpu()
+    for topic, now, msg in items:
+        engine.on_message(topic, now, msg)
+    return round((cpu() - t0) / len(items) * 1e6, 2)
+
+
+def _engine(spec):
+    def make():
+        engine = Engine(spec, 0.0)
+        engine.evaluate_all(0.0)
+        return engine
+    return make
+
+
+def _machine() -> dict:
+    """Machine facts, with the load average: the machine may be shared while this runs."""
+    return {**_common.machine(), "loadavg_1min": round(os.getloadavg()[0], 2)}
+
+
 def _figures(costs):
     return {"mean_us": round(sum(costs) / len(costs) * 1e6, 2),
             "p50_us": round(_common.percentile(costs, 50) * 1e6, 2),
@@ -143,8 +168,6 @@ def _figures(costs):
 def engine_per_message(n_rules: int, n_messages: int) -> dict:
     """(a): messages alternate between /odom (a stamped Odometry) and /scan (8 beams)."""
     spec = check_text(spec_text(n_rules), SPEC_PATH, [_common.LIB])
-    engine = Engine(spec, 0.0)
-    engine.evaluate_all(0.0)
     rng = random.Random(1)
     t, msgs = 0.0, []
     v, w, x, y, d = 0.3, 0.0, 4.0, 2.0, 2.0
@@ -158,6 +181,8 @@ def engine_per_message(n_rules: int, n_messages: int) -> dict:
             w = min(1.0, max(-1.0, w + rng.gauss(0, 0.01)))
             x, y = min(9.0, max(3.5, x + rng.gauss(0, 0.02))), min(4.5, max(0.5, y + rng.gauss(0, 0.02)))
             msgs.append(("/odom", t, Odometry(t - rng.uniform(0.01, 0.05), x, y, v, w)))
+    cpu_us = _cpu_us(_engine(spec), msgs)
+    engine = _engine(spec)()
     costs = []
     clock = time.perf_counter
     events = 0
@@ -165,12 +190,12 @@ def engine_per_message(n_rules: int, n_messages: int) -> dict:
         t0 = clock()
         events += len(engine.on_message(topic, now, msg))
         costs.append(clock() - t0)
-    mean_us = sum(costs) / len(costs) * 1e6
     # every rule the messages feed must have a value by the end, or the run measured nothing
     unknown = [r.key for r in spec.rules if r.key.startswith("hot.") and engine.rule_value(r.key) is UNKNOWN]
     return {"benchmark": "engine_v2", "figure": "per_message", "rules": len(spec.rules),
             "dependent_rules": HOT_RULES, "behaviours": len(spec.behaviours), "messages": n_messages,
-            "events": events, "unknown_at_end": unknown, **_figures(costs), "target_us": 10, "met": mean_us <= 10, **_common.machine()}
+            "events": events, "unknown_at_end": unknown, "cpu_us": cpu_us, **_figures(costs),
+            "target_us": 10, "met": cpu_us <= 10, **_machine()}
 
 
 LASER = """entity laser { rules:
@@ -186,8 +211,6 @@ if (laser.left or laser.right) then { slow_down; }
 def laser_scan(n_scans: int) -> dict:
     """(b): 1,081 beams, about 5 % +inf (no return) and 2 % NaN, as a real 270° scanner sends."""
     spec = check_text("action primitive slow_down, board_stop;\n" + LASER, SPEC_PATH, [_common.LIB])
-    engine = Engine(spec, 0.0)
-    engine.evaluate_all(0.0)
     rng = random.Random(2)
     scans = []
     for k in range(n_scans):
@@ -197,35 +220,40 @@ def laser_scan(n_scans: int) -> dict:
         for i in rng.sample(range(1081), 22):
             r[i] = math.nan
         scans.append(LaserScan(0.025 * (k + 1), tuple(r)))
+    items = [("/scan", 0.025 * (k + 1), scan) for k, scan in enumerate(scans)]
+    cpu_us = _cpu_us(_engine(spec), items)
+    engine = _engine(spec)()
     costs = []
     clock = time.perf_counter
-    for k, scan in enumerate(scans):
-        now = 0.025 * (k + 1)
+    for topic, now, scan in items:
         t0 = clock()
-        engine.on_message("/scan", now, scan)
+        engine.on_message(topic, now, scan)
         costs.append(clock() - t0)
-    mean_us = sum(costs) / len(costs) * 1e6
     unknown = [r.key for r in spec.rules if engine.rule_value(r.key) is UNKNOWN]
     return {"benchmark": "engine_v2", "figure": "laser_scan", "beams": 1081, "sector_rules": 3,
-            "scans": n_scans, "unknown_at_end": unknown, **_figures(costs), "target_us": 50, "met": mean_us <= 50, **_common.machine()}
+            "scans": n_scans, "unknown_at_end": unknown, "cpu_us": cpu_us, **_figures(costs),
+            "target_us": 50, "met": cpu_us <= 50, **_machine()}
 
 
 def parse_and_check(n_rules: int, repeat: int) -> dict:
     """(c): the spec of (a) with n_rules rules, parsed and checked against the example library."""
     text = spec_text(n_rules)
-    parse_times, total_times = [], []
+    parse_times, total_times, cpu_times = [], [], []
     for _ in range(repeat):
         t0 = time.perf_counter()
         parse_source(Source(SPEC_PATH, text))
         parse_times.append(time.perf_counter() - t0)
-        t0 = time.perf_counter()
+        t0, c0 = time.perf_counter(), time.process_time()
         spec = check_text(text, SPEC_PATH, [_common.LIB])
         total_times.append(time.perf_counter() - t0)
-    median = statistics.median(total_times)
+        cpu_times.append(time.process_time() - c0)
+    median = statistics.median(cpu_times)
     return {"benchmark": "engine_v2", "figure": "parse_check", "rules": len(spec.rules),
             "spec_bytes": len(text.encode()), "parse_s_median": round(statistics.median(parse_times), 4),
-            "parse_and_check_s_median": round(median, 4), "parse_and_check_s_max": round(max(total_times), 4),
-            "target_s": 1.0, "met": median < 1.0, **_common.machine()}
+            "parse_and_check_cpu_s_median": round(median, 4),
+            "parse_and_check_s_median": round(statistics.median(total_times), 4),
+            "parse_and_check_s_max": round(max(total_times), 4),
+            "target_s": 1.0, "met": median < 1.0, **_machine()}
 
 
 def main() -> None:
