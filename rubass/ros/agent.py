@@ -135,6 +135,14 @@ class Agent:
                 if name not in names and st.alive is False:
                     del self.sampler.status[name]
 
+    def discover_every(self, period: float, stop: threading.Event) -> None:
+        """discover() every `period` seconds until `stop` is set (on a thread of its own)."""
+        while not stop.wait(period):
+            try:
+                self.discover()
+            except Exception as exc:  # never let discovery die: log and try again
+                self.log("error", f"rubass agent: discovery failed: {exc.__class__.__name__}: {exc}")
+
     def step(self, now: float) -> str:
         """Sample every node of this host (in parallel) and return the report's JSON."""
         with self._lock:
@@ -176,11 +184,11 @@ def main(argv: Optional[List[str]] = None) -> int:
     rospy.on_shutdown(stop.set)
     rospy.loginfo("rubass agent %s: reporting the nodes on host %s (%s) at %g Hz on %s", rospy.get_name(), host,
                   ", ".join(agent.addresses) or "no address", rate, AGENT_TOPIC)
-    next_at = next_discover = time.monotonic()
+    agent.discover()
+    threading.Thread(target=agent.discover_every, args=(discover_period, stop), name="rubass-discover",
+                     daemon=True).start()  # a slow or hung master must not delay the reports
+    next_at = time.monotonic()
     while not stop.is_set() and not rospy.is_shutdown():
-        if time.monotonic() >= next_discover:
-            agent.discover()
-            next_discover = time.monotonic() + discover_period
         try:
             pub.publish(String(data=agent.step(rospy.get_rostime().to_sec())))
         except Exception as exc:  # a bad node must not stop the reports of the others

@@ -217,6 +217,27 @@ def test_agent_launch_reports_the_nodes_of_its_host(ros, tmp_path):
     assert launch.wait(20) == 0
 
 
+def test_an_agent_keeps_reporting_while_the_master_hangs(ros):
+    agent = ros.spawn([PY, os.path.join(ROOT, "scripts", "agent"), "_node_rate:=10", "_discover_rate:=5"], "agent")
+    probe = ros.probe_bg({"listen": [{"topic": "/rubass/agent_samples", "type": "std_msgs/String"}],
+                          "steps": [{"wait": "/rubass/agent_samples", "timeout": 30}, {"sleep": 1.2},
+                                    {"mark": "ready"}, {"sleep": 3.0}]})
+    line = probe.stdout.readline()
+    while line and '"ready"' not in line:
+        line = probe.stdout.readline()
+    assert '"ready"' in line, ros.log(agent)
+    os.kill(ros.master.process.pid, signal.SIGSTOP)  # discovery now waits on the master (1 s timeouts)
+    try:
+        hung = time.time()
+        time.sleep(2.6)
+    finally:
+        os.kill(ros.master.process.pid, signal.SIGCONT)
+    out, _ = probe.communicate(timeout=30)
+    during = [json.loads(x) for x in out.splitlines() if x.startswith("{")]
+    during = [r for r in during if r["kind"] == "recv" and hung + 0.5 < r["wall"] < hung + 2.5]
+    assert len(during) >= 10, f"{len(during)} reports in 2 s while the master hung\n{ros.log(agent)}"
+
+
 def test_an_agent_with_a_bad_rate_says_which_parameter(ros):
     proc = ros.spawn([PY, os.path.join(ROOT, "scripts", "agent"), "_node_rate:=fast"], "agent-bad")
     assert proc.wait(30) == 1
