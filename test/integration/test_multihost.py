@@ -260,8 +260,9 @@ def test_a_bad_report_is_ignored_and_the_monitor_goes_on(ros, tmp_path):
 
 
 def test_a_killed_agent_makes_its_hosts_rules_unknown_and_the_status_names_it(cluster, tmp_path):
-    spec = write_spec(tmp_path, "entity arm: calm { rules: busy: cpu(node calm) > 95 %; }\n"
-                                "if (arm.busy) then { warn(\"busy\"); }\n")
+    spec = write_spec(tmp_path, "entity arm: calm { rules: busy: cpu(node calm) > 95 %;\n"
+                                "  down: not alive(node calm); }\n"
+                                "if (arm.busy or arm.down) then { warn(\"arm\"); }\n")
     watch = start_everywhere(cluster, spec, ("arm", "calm", "talk", "/arm_state", "5"))
     wait_for(cluster, "arm's rule known (false) from its agent",
              lambda: [s for s in statuses(watch, "rubass: arm") if s[1] == "all rules false"], timeout=40)
@@ -271,6 +272,7 @@ def test_a_killed_agent_makes_its_hosts_rules_unknown_and_the_status_names_it(cl
     silent = wait_for(cluster, "the arm's rule unknown because its agent is silent",
                       lambda: [s for s in statuses(watch, "rubass: arm") if s[0] > killed and s[1] == "unknown: busy"])
     why = silent[-1][2]["busy unknown because"]
+    assert silent[-1][2]["down"] == "false"  # alive() asks the node itself, not the agent
     arm = cluster.net.address["arm"]
     assert f"agent /rubass_agent_{arm.replace('.', '_')} on host {arm} is silent" in why, why
     mon = wait_for(cluster, "the monitor's status names the silent agent",
