@@ -176,6 +176,12 @@ class Monitor:
                      "~heartbeat (a watchdog fed by it stops the robot); fix the file, then SIGHUP or "
                      "rosservice call ~reload", error)
 
+    def _why_not(self) -> str:
+        """Why the monitor is not enforcing (before its engine runs)."""
+        if self.load_error:
+            return self.load_error
+        return "waiting for the first /clock message (use_sim_time)" if self.spec is not None else "starting"
+
     def _first_time(self) -> float:
         """ROS time now; with use_sim_time, the first /clock message's (watching starts then, not at 0)."""
         now = _ros_now()
@@ -327,6 +333,8 @@ class Monitor:
                 self._check_overload_actions(spec)
                 self._check_library_types(spec)
                 t_check = time.monotonic()
+                if self.spec is not None and self.loop is None:
+                    raise StartupError(f"not enforcing yet: {self._why_not()}; reload once it enforces")
                 if self.spec is None:  # not enforcing yet: this spec is the first usable one
                     self._enforce(spec, self._runners(spec, {}))
                     self.reloads += 1
@@ -406,7 +414,7 @@ class Monitor:
         now = _ros_now()
         loop = self.loop
         if loop is None:
-            return False, f"not enforcing any rule (the spec cannot be used): {self.load_error.splitlines()[0]}"
+            return False, f"not enforcing any rule: {self._why_not()}"
 
         def do(engine: Engine) -> int:
             events = engine.reset(now)
@@ -429,7 +437,7 @@ class Monitor:
 
     def publish_status(self) -> None:
         if self.loop is None:
-            self.outputs.status(status_mod.not_enforcing(self.config.spec, self.load_error, self.reloads,
+            self.outputs.status(status_mod.not_enforcing(self.config.spec, self._why_not(), self.reloads,
                                                          self.rejected), _ros_now())
             return
         loop = self.loop
