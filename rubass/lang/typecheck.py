@@ -307,7 +307,12 @@ class ExprChecker(BuiltinChecks):
     def _same_dim(self, a: Ty, b: Ty, span: Span, template: str) -> None:
         if a.kind == b.kind == "num" and a.dim is not None and b.dim is not None \
                 and not a.bare and not b.bare and a.dim != b.dim:
-            self.error(span, template.format(f"a {dimension_name(a.dim)}", f"a {dimension_name(b.dim)}"))
+            self.error(span, template.format(_a(dimension_name(a.dim)), _a(dimension_name(b.dim))))
+
+
+def _a(noun: str) -> str:
+    """The noun with its indefinite article: 'a time', 'an acceleration'."""
+    return ("an " if noun[:1] in "aeiou" else "a ") + noun
 
 
 def _join(a: Ty, b: Ty) -> Ty:
