@@ -148,8 +148,9 @@ class Agent:
         with self._lock:
             statuses = list(self.sampler.status.values())
         list(self._pool.map(self.sampler.sample, statuses))
-        nodes = [node_entry(st.resolved, now, st.alive, st.cpu, st.memory, st.pid, self.sampler._uris.get(st.resolved, ""),
-                            st.why) for st in statuses]
+        uris = self.sampler._uris
+        nodes = [node_entry(st.resolved, now, st.alive, st.cpu, st.memory, st.pid, uris.get(st.resolved, ""), st.why)
+                 for st in statuses]
         self.seq += 1
         return encode(self.name, self.host, self.addresses, now, self.period, self.seq, nodes)
 

@@ -4,8 +4,9 @@ Each host is a namespace with `lo` and one interface `eth0` (a veth pair whose o
 on a bridge in a "switch" namespace), at 10.200.0.N/24. Those addresses exist only inside
 the namespaces made here, so no traffic leaves them. `cut(host)` takes the host's link down
 on the switch side (the cable pulled); `close()` stops what still runs in them and deletes
-every namespace (and with them their veths and the bridge). Namespace names carry this process's pid: leftovers of a killed test run are
-removed by the next run. Needs root and iproute2; `Network.check()` says why not.
+every namespace (and with them their veths and the bridge). Namespace names carry this
+process's pid: leftovers of a killed test run are removed by the next run. Needs root and
+iproute2; `Network.check()` says why not.
 """
 import os
 import re

@@ -251,7 +251,8 @@ def test_a_bad_report_is_ignored_and_the_monitor_goes_on(ros, tmp_path):
     ros.probe({"advertise": [{"topic": "/rubass/agent_samples", "type": "std_msgs/String"}],
                "steps": [{"wait_subscribers": "/rubass/agent_samples"}, {"sleep": 0.3},
                          {"publish": "/rubass/agent_samples", "msg": {"data": "{not json"}},
-                         {"publish": "/rubass/agent_samples", "msg": {"data": '{"agent": "/a", "period": -1, "nodes": []}'}},
+                         {"publish": "/rubass/agent_samples",
+                          "msg": {"data": '{"agent": "/a", "period": -1, "nodes": []}'}},
                          {"sleep": 0.5}]})
     from rosharness import wait_log
 
