@@ -77,14 +77,17 @@ class Experiments:
         return self.out / "runs" / RUN_DIR / str(rep) / "run.bag"
 
     def wait_recording(self, rep, timeout=120.0):
-        """Until run `rep` is recording with its nodes up, then a second more."""
+        """Until run `rep` is recording and its monitor enforces the spec (its nodes have been up
+        for a while: the bag holds messages), then half a second more: the run still has its
+        warm-up (1.5 s) before the fault."""
         active = str(self.bag(rep)) + ".active"
+        monitor_log = self.bag(rep).parent / "monitor.log"
         end = time.time() + timeout
-        while not os.path.exists(active):
-            assert self.proc.poll() is None, f"exited {self.proc.returncode} before run {rep} recorded\n{self.text()}"
-            assert time.time() < end, f"run {rep} never started recording\n{self.text()}"
+        while not (os.path.exists(active) and monitor_log.exists() and "enforcing" in monitor_log.read_text()):
+            assert self.proc.poll() is None, f"exited {self.proc.returncode} before run {rep} was up\n{self.text()}"
+            assert time.time() < end, f"run {rep} never came up\n{self.text()}"
             time.sleep(0.1)
-        time.sleep(1.0)
+        time.sleep(0.5)
         assert os.path.exists(active), f"run {rep} ended before the signal could interrupt it\n{self.text()}"
 
     def wait_gone(self, timeout):
