@@ -468,6 +468,7 @@ class Monitor:
                 monitor[f"action {name}"] = r.stats.last_error
         monitor.update(self.keeper.status())
         monitor["clock jumps back"] = loop.clock_jumps
+        monitor["last start"] = getattr(self.dispatcher, "last_start", "none")  # with its witnesses
         monitor["data errors"] = "; ".join(data_errors) or "none"
         if self.error_guard.active:
             monitor["data error actions"] = "running " + ", ".join(self.error_guard.actions)
