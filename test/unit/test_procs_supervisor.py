@@ -137,3 +137,12 @@ def test_leaving_stops_every_process_and_tells_the_reaper_goodbye(mark):
     pids = [int(p) for p in child.stdout.readline().split()]
     assert child.wait(10) == 0
     assert _wait_dead(pids, 2.0) == []
+
+
+def test_an_adopted_process_outside_any_group_of_its_own_is_stopped_too():
+    with Supervisor(signals=False) as sup:
+        p = subprocess.Popen(["sleep", "60"])  # in this process's group: killpg(p.pid) finds no group
+        sup.adopt(p)
+        t0 = time.monotonic()
+        sup.stop([p])
+        assert p.returncode == -signal.SIGTERM and time.monotonic() - t0 < 4.0

@@ -179,12 +179,12 @@ class Supervisor:
         with self.deferred(raise_after=False):
             for p in procs:
                 if p.poll() is None:
-                    _killpg(p.pid, self._stop_sig.get(p.pid, signal.SIGTERM))
+                    _signal_group(p, self._stop_sig.get(p.pid, signal.SIGTERM))
             for p in procs:
                 try:
                     p.wait(timeout)
                 except subprocess.TimeoutExpired:
-                    _killpg(p.pid, signal.SIGKILL)
+                    _signal_group(p, signal.SIGKILL)
                     p.wait()
                 if p in self._procs:
                     self._procs.remove(p)
@@ -246,9 +246,13 @@ def supervise_script(prog: str) -> Supervisor:
     return sup
 
 
-def _killpg(pgid: int, sig: int) -> None:
-    with contextlib.suppress(ProcessLookupError, PermissionError):
-        os.killpg(pgid, sig)
+def _signal_group(proc: subprocess.Popen, sig: int) -> None:
+    """Signal the process's group, or the process alone when it leads none."""
+    try:
+        os.killpg(proc.pid, sig)
+    except (ProcessLookupError, PermissionError):
+        with contextlib.suppress(OSError):
+            proc.send_signal(sig)
 
 
 def _ours(marker: str) -> Dict[int, int]:
