@@ -110,7 +110,9 @@ class Engine:
                 elif isinstance(e, ast.NodeStat):
                     nodes.add(e.node)
                 elif isinstance(e, ast.Rate):
-                    self._rate_paths.setdefault(e.ref.topic, []).append(e.ref.path)
+                    paths = self._rate_paths.setdefault(e.ref.topic, [])
+                    if e.ref.path not in paths:  # one rate per field, however many rules use it
+                        paths.append(e.ref.path)
                 elif isinstance(e, ast.ArrayFn) and e.ref.path[:1] == ("ranges",):
                     self._laser.add(e.ref.topic)
                 elif isinstance(e, ast.Active):
@@ -127,8 +129,7 @@ class Engine:
         self._readers = readers
         for topic in spec.topics:
             self.store.watch(topic, now, windows.get(topic, 0.0))
-        self._paths = {t: tuple(sorted((p for p in u.paths if p not in self._rate_paths.get(t, ()) and p != STAMP),
-                                       key=str))
+        self._paths = {t: tuple(sorted((p for p in u.paths if p != STAMP), key=str))  # rate fields too
                        for t, u in spec.topics.items()}
         self._topic_plans = {t: self._plan([i for i, s in enumerate(topics_of) if t in s]) for t in spec.topics}
         self._node_plans = {n: self._plan([i for i, s in enumerate(nodes_of) if n in s]) for n in spec.nodes}
@@ -180,8 +181,8 @@ class Engine:
         store.arrive(topic, now)
         for path in self._paths.get(topic, ()):
             store.fields[(topic, path)] = self._read(topic, path, msg)
-        for path in self._rate_paths.get(topic, ()):
-            store.arrive_rate(topic, path, now, self._read(topic, path, msg))
+        for path in self._rate_paths.get(topic, ()):  # read above, as a plain field
+            store.arrive_rate(topic, path, now, store.fields.get((topic, path), UNKNOWN))
         if topic in self._stamped:
             try:
                 stamp = UNKNOWN if msg is UNKNOWN else _stamp(extract(msg, STAMP, raw=True))
