@@ -65,10 +65,11 @@ def _laser(pick: Callable[..., float], ranges: Any, lim: Tuple[float, float]) ->
     if not isinstance(ranges, tuple):
         return UNKNOWN
     if ranges:
-        total = sum(ranges)  # NaN when a reading is NaN: then min/max are not reliable
-        m, n = min(ranges), max(ranges)  # C speed; exact when every reading is within the limits
-        if total == total and lo <= m and n <= hi:
-            return float(pick(m, n))
+        total = sum(ranges)  # NaN when a reading is NaN (or both infinities): min/max unreliable then
+        if total == total:  # C speed for the usual scan: readings in range plus +inf for no return
+            best = pick(ranges)
+            if lo <= best <= hi:  # the extreme itself is a valid reading, so it is the answer
+                return float(best)
     valid = [v for v in ranges if lo <= v <= hi]
     if -math.inf in ranges:
         valid.append(0.0)
