@@ -9,7 +9,7 @@ pytestmark = pytest.mark.ros
 
 
 def test_events_and_diagnostics_carry_the_witness(ros, tmp_path):
-    ros.monitor(spec(tmp_path, '@hazard("H1") entity a { rules: @id("SR-1") r: topic /x.data > 1; }\n"
+    ros.monitor(spec(tmp_path, '@hazard("H1") entity a { rules: @id("SR-1") r: topic /x.data > 1; }\n'
                                '@id("SF-1") fast: if (a.r) then { brake; }\n'))
     rec = ros.probe({"listen": [{"topic": "/rubass/events", "type": "std_msgs/String"},
                                 {"topic": "/diagnostics", "type": "diagnostic_msgs/DiagnosticArray"}],
