@@ -130,3 +130,14 @@ def test_monitor_events_and_diagnostics_carry_the_witness():
     assert rec["event"] == "start" and rec["witnesses"] == {"/odom.twist.twist.linear.x": 0.62}
     assert rec["rules"] == ["base.too_fast"]
     assert d.last_start == "behaviour 1 at 0.300 s: true: base.too_fast; /odom.twist.twist.linear.x = 0.62"
+
+
+def test_witness_benchmark_runs_and_finds_no_call_on_the_message_path():
+    import subprocess
+    import sys
+
+    out = subprocess.run([sys.executable, os.path.join(ROOT, "bench", "witness.py"), "--messages", "200"],
+                         capture_output=True, text=True, timeout=120)
+    assert out.returncode == 0, out.stderr
+    figures = json.loads(out.stdout)
+    assert figures["explain_calls_on_the_message_path"] == 0 and figures["one_witness_us"] > 0
