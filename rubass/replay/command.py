@@ -90,6 +90,17 @@ def run(args: argparse.Namespace) -> int:
         if errors:
             print("\n".join(errors), file=sys.stderr)
             return 1
+        try:  # the recording's types as a system model: an array used as a number, len() of a
+            # string… are errors at the spec's line, as `rubass check --bag` reports them (issue 20.6)
+            from ..ros.model_sources import bag_model
+
+            load_spec(args.spec, args.actions, model=bag_model(args.bag))
+        except SpecError as exc:
+            print(exc.render(), file=sys.stderr)
+            return 1
+        except BagError as exc:
+            print(f"rubass replay: error: {exc}", file=sys.stderr)
+            return 1
         from .run import replay
 
         node_topics = node_topics if spec.nodes else []

@@ -152,3 +152,20 @@ def test_real_turtlebot_recording():
     # into it, at the instant of the crossing rather than at the next tick
     silent = [s["time"] for s in starts if s["behaviour"] == 1]
     assert len(silent) == 1 and silent[0] == pytest.approx(16.0, abs=0.01)
+
+
+@pytest.mark.parametrize("rule,words", [
+    ("topic /data.data > 0", "is an array"),
+    ("len(topic /name.data) > 3", "is not an array"),
+    ("min(topic /name.data) > 3", "is not an array"),
+])
+def test_type_misuse_is_rejected_at_its_line(write, tmp_path, rule, words):  # issue 20.6
+    from std_msgs.msg import Float64MultiArray
+
+    arr = Float64MultiArray()
+    arr.data = [1.0, 2.0]
+    bag = write_bag(str(tmp_path / "b.bag"), [(0.0, "/data", arr), (0.0, "/name", String("abc"))])
+    spec = spec_file(write, f"entity base {{ rules: r: {rule}; }}\nif (base.r) then {{ stop; }}\n")
+    proc = replay(spec, bag)
+    assert proc.returncode == 1 and proc.stdout == ""
+    assert f"{spec}:3:" in proc.stderr and words in proc.stderr and "^" in proc.stderr, proc.stderr
