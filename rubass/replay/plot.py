@@ -25,7 +25,7 @@ def plot(spec: CheckedSpec, events: List[Event], end: float, path: str, title: s
     import matplotlib.pyplot as plt
     from matplotlib.patches import Patch
 
-    rows: List[str] = [r.key for r in spec.rules] + [f"behaviour {b.index} (line {b.span.line})" for b in spec.behaviours]
+    rows: List[str] = [r.key for r in spec.rules] + [f"{b.label} (line {b.span.line})" for b in spec.behaviours]
     fig, ax = plt.subplots(figsize=(12, 0.45 * len(rows) + 1.6))
     end = max(end, 1e-3)
     for y, rule in enumerate(spec.rules):
