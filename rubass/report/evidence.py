@@ -132,15 +132,15 @@ def build_matrix(ev: Evidence) -> None:
         for r in rules:
             users = [b for b in spec.behaviours if r.key in uses[b.index]]
             ids = set(attrs(r).get("id", ()))
-            for b in users:
-                ids |= set(attrs(b).get("id", ()))
-            tests = [o for o in outcomes if ids & set(o.covers) or r.key in o.rules_true]
+            tests = [o for o in outcomes if ids & set(o.covers)]  # tests that name the rule's @id
+            if not tests:  # else the tests that made it true (weaker evidence, but evidence)
+                tests = [o for o in outcomes if r.key in o.rules_true]
             ev.matrix.append(Row(h, r.key, [behaviour_label(spec, b.index) for b in users], tests, _gaps(users, tests)))
         for b in direct_b:
             if any(r.key in uses[b.index] for r in rules):
                 continue  # shown with its rule
             ids = set(attrs(b).get("id", ()))
-            tests = [o for o in outcomes if ids & set(o.covers) or b.index in o.started]
+            tests = [o for o in outcomes if ids & set(o.covers)] or [o for o in outcomes if b.index in o.started]
             ev.matrix.append(Row(h, None, [behaviour_label(spec, b.index)], tests, _gaps([b], tests)))
     if outcomes:
         ev.coverage = coverage(spec, outcomes)

@@ -96,8 +96,8 @@ def _matrix(ev: Evidence) -> str:
         rows.append(f"<tr><td><b>{_e(h.id)}</b> {_e(h.title)}<br><span class='muted'>{_e(details)}</span></td>"
                     f"<td>{rule_cell}</td><td>{_list(row.behaviours)}</td><td>{tests}</td>{status}</tr>")
     note = ("<p>Each hazard of the risk assessment, the rules that detect it (<code>@hazard</code>), the behaviours "
-            "that act on those rules, and the tests that cover them (by <code>covers</code>, or by making the rule "
-            "true). Gaps are marked red: a hazard with no rule, a rule with no test, a failing test.</p>")
+            "that act on those rules, and the tests that cover them (those whose <code>covers</code> names the rule's "
+            "<code>@id</code>; when none does, those that made the rule true). Gaps are marked red: a hazard with no rule, a rule with no test, a failing test.</p>")
     return "<h2 id='matrix'>Hazard → rule → behaviour → test</h2>" + note + \
         _table(["hazard", "rule", "behaviours", "tests", "status"], rows)
 

@@ -34,6 +34,7 @@ tests:
       - {at: 2 s, start: overspeed}
       - {at: 3 s, release: overspeed}
   - name: a wrong expectation
+    covers: [SR-1]
     topics:
       /odom: {type: nav_msgs/Odometry, rate: 10 Hz, field: twist.twist.linear.x, values: "0x10 0.6x20"}
     expect:
