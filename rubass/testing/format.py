@@ -86,11 +86,13 @@ class TestFile:
     spec_line: int
     actions: List[str]
     cases: List[Case]
+    model: Any = None  # the system model (rubass.lang.sysmodel.SystemModel) named by `model:`, if any
 
 
 class _Reader:
     def __init__(self, path: str) -> None:
         self.path = path
+        self.registry: Any = None  # message definitions of the system model, when the file names one
 
     def fail(self, line: int, message: str) -> TestFileError:
         return TestFileError(self.path, line, message)
@@ -136,7 +138,7 @@ class _Reader:
     # -- the file ---------------------------------------------------------------------------
     def read(self) -> TestFile:
         doc = load(self.path)
-        top = self.mapping(doc, 1, "a test file", ("spec", "actions", "tests"), ("spec", "tests"))
+        top = self.mapping(doc, 1, "a test file", ("spec", "actions", "model", "tests"), ("spec", "tests"))
         spec = top["spec"]
         if not isinstance(spec, str) or not spec:
             raise self.fail(top.at("spec"), "spec must be the path of a .rbs file")
@@ -144,6 +146,8 @@ class _Reader:
         listed = top.get("actions", LList())
         listed = [listed] if isinstance(listed, str) else self.seq(listed, top.at("actions"), "actions")
         actions = [os.path.join(base, str(a)) for a in listed]
+        model = self.model(top, base) if "model" in top else None
+        self.registry = model.registry if model is not None else None
         tests = self.seq(top["tests"], top.at("tests"), "tests")
         if not tests:
             raise self.fail(top.at("tests"), "tests is empty: a file needs at least one test")
@@ -153,7 +157,22 @@ class _Reader:
             if c.name in seen:
                 raise self.fail(c.line, f"a second test named '{c.name}' (the first is at line {seen[c.name]})")
             seen[c.name] = c.line
-        return TestFile(self.path, os.path.normpath(os.path.join(base, spec)), top.at("spec"), actions, cases)
+        return TestFile(self.path, os.path.normpath(os.path.join(base, spec)), top.at("spec"), actions, cases, model)
+
+    def model(self, top: LDict, base: str) -> Any:
+        """The system model file named by `model:` (relative to the test file)."""
+        from ..lang.modelfile import load_model
+        from ..lang.source import SourceSet
+
+        name = top["model"]
+        if not isinstance(name, str) or not name:
+            raise self.fail(top.at("model"), "model must be the path of a system model file (docs/model.md)")
+        sources = SourceSet()
+        model, diags = load_model(os.path.join(base, name), sources)
+        if model is None:
+            text = "\n".join(d.render(sources) for d in diags)
+            raise self.fail(top.at("model"), f"system model {name} cannot be used:\n{text}")
+        return model
 
     def case(self, value: Any, line: int, i: int) -> Case:
         t = self.mapping(value, line, "a test", ("name", "covers", "duration", "topics", "nodes", "expect",
@@ -180,7 +199,7 @@ class _Reader:
         t = self.mapping(value, line, f"topic {topic}", ("type", "rate", "start", "field", "fields", "values",
                                                          "messages"), ("type",))
         try:
-            cls = message_class(t["type"])
+            cls = message_class(t["type"], self.registry)
         except MessageError as exc:
             raise self.fail(t.at("type"), str(exc)) from None
         case.topics[topic] = TopicInput(topic, t["type"], cls, line)

@@ -22,18 +22,51 @@ class MessageError(ValueError):
     """A type that is not installed, or a field or value the type does not allow."""
 
 
-def message_class(type_name: Any) -> Any:
-    """The installed class of `pkg/Name`, or MessageError."""
-    if not isinstance(type_name, str) or not re.fullmatch(r"[A-Za-z_][\w]*/[A-Za-z_]\w*", type_name):
-        raise MessageError(f"'{type_name}' is not a message type (pkg/Name, e.g. nav_msgs/Odometry)")
+_DYNAMIC: Dict[str, Any] = {}  # classes built from system models, by type name
+
+
+def model_class(type_name: str, registry: Any) -> Any:
+    """A class built from a system model's definitions (a type not installed here), or None."""
+    specs = registry.closure([type_name]) if registry is not None else []
+    if not specs or specs[0].type != type_name:
+        return None
+    sep = "\n" + "=" * 80 + "\n"
+    text = specs[0].text() + "".join(f"{sep}MSG: {d.type}\n{d.text()}" for d in specs[1:])
+    known = {d.type for d in specs}
+    for dep in sorted({f.type for d in specs for f in d.fields if not f.is_primitive} - known):
+        installed = _installed(dep)  # e.g. std_msgs/Header: the model holds only the robot's own types
+        if installed is not None:
+            text += f"{sep}MSG: {dep}\n{installed._full_text}"
+    try:
+        import genpy.dynamic
+
+        classes = genpy.dynamic.generate_dynamic(type_name, text)
+    except Exception as exc:  # genpy raises assorted errors for a definition it cannot build
+        raise MessageError(f"message type {type_name}: the system model's definition cannot be built ({exc})") from None
+    _DYNAMIC.update(classes)  # its nested types too, for arrays of them
+    return classes[type_name]
+
+
+def _installed(type_name: str) -> Any:
     try:
         import roslib.message
 
-        cls = roslib.message.get_message_class(type_name)
+        return roslib.message.get_message_class(type_name)
     except Exception:  # roslib raises assorted errors for unknown packages
-        cls = None
+        return None
+
+
+def message_class(type_name: Any, registry: Any = None) -> Any:
+    """The installed class of `pkg/Name`, else one built from the system model's definition
+    (`registry`: a rubass.lang.msgdef.Registry), or MessageError."""
+    if not isinstance(type_name, str) or not re.fullmatch(r"[A-Za-z_][\w]*/[A-Za-z_]\w*", type_name):
+        raise MessageError(f"'{type_name}' is not a message type (pkg/Name, e.g. nav_msgs/Odometry)")
+    cls = _installed(type_name)
     if cls is None:
-        raise MessageError(f"message type {type_name} is not installed here (is its Debian package installed?)")
+        cls = model_class(type_name, registry)
+    if cls is None:
+        raise MessageError(f"message type {type_name} is not installed here (is its Debian package installed?)"
+                           + ("" if registry is None else " and the system model does not define it"))
     return cls
 
 
@@ -71,7 +104,7 @@ def _slot_type(obj: Any, name: str, done: Path) -> str:
 def _nested_class(type_name: str) -> Any:
     if type_name == "Header":
         type_name = "std_msgs/Header"
-    return message_class(type_name)
+    return _DYNAMIC.get(type_name) or message_class(type_name)
 
 
 def _scalar(slot: str, value: Any, where: str) -> Any:

@@ -30,7 +30,7 @@ def run_file(path: str, extra_actions: Sequence[str] = ()) -> FileResult:
         tf = read_test_file(path)
         result.spec_path = tf.spec
         try:
-            spec = load_spec(tf.spec, list(tf.actions) + list(extra_actions))
+            spec = load_spec(tf.spec, list(tf.actions) + list(extra_actions), model=tf.model)
         except SpecError as exc:
             raise TestFileError(path, tf.spec_line, f"spec {tf.spec} cannot be used:\n{exc.render()}") from None
         result.spec = spec

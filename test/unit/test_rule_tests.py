@@ -331,3 +331,47 @@ tests:
 """)
     code, out, err = run(capsys, path)
     assert code == 0, out + err
+
+
+def test_types_not_installed_come_from_the_system_model(write, capsys):
+    write("lib.yaml", LIB)
+    write("robot.model.yaml", """rubass_model: 1
+topics:
+  /bms: my_robot_msgs/Battery
+definitions:
+  my_robot_msgs/Battery: |
+    std_msgs/Header header
+    float64 voltage
+    my_robot_msgs/Cell[] cells
+  my_robot_msgs/Cell: |
+    float64 voltage
+    string name
+""")
+    write("b.rbs", """import "lib.yaml";
+action primitive stop;
+entity bat { rules: low: topic /bms.voltage < 11 and stamp_age(topic /bms) < 1 s;
+                    weak: min(topic /bms.cells[*].voltage) < 3; }
+low_battery: if (bat.low or bat.weak) then { stop; }
+""")
+    body = """spec: b.rbs
+model: robot.model.yaml
+tests:
+  - name: low battery, then a weak cell
+    topics:
+      /bms:
+        type: my_robot_msgs/Battery
+        messages:
+          - {at: 0.5 s, voltage: 12.0, cells: [{voltage: 4.0, name: a}]}
+          - {at: 1 s, voltage: 10.5}
+          - {at: 2 s, voltage: 12.0, cells: [{voltage: 2.5, name: a}]}
+          - {at: 3 s, voltage: 12.0, cells: [{voltage: 4.0, name: a}]}
+    expect:
+      - {at: 1 s, start: low_battery}
+      - {at: 3 s, release: low_battery}
+"""
+    code, out, err = run(capsys, write("b.test.yaml", body))
+    assert code == 0, out + err
+    code, _, err = run(capsys, write("c.test.yaml", body.replace("model: robot.model.yaml\n", "")))
+    assert code == 2 and "my_robot_msgs/Battery is not installed" in err
+    code, _, err = run(capsys, write("d.test.yaml", body.replace("voltage: 10.5", "voltag: 10.5")))
+    assert code == 2 and "has no field 'voltag'" in err
