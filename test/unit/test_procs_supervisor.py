@@ -105,6 +105,7 @@ def test_a_stop_signal_raises_interrupted_once_and_everything_is_stopped(mark, s
 def test_a_signal_while_deferred_is_raised_on_leaving():
     sup = Supervisor()
     with sup:
+        assert signal.getsignal(signal.SIGTERM) == sup._on_signal  # or the SIGTERM below would end pytest
         with pytest.raises(Interrupted) as exc:
             with sup.deferred():
                 os.kill(os.getpid(), signal.SIGTERM)
