@@ -15,8 +15,11 @@ class Row:
     fault: Dict[str, Any] = field(hash=False)
     origin: str                     # event the paper's timing (a) starts from
     ideal: float
-    paper: Tuple[float, float, float, float]  # Avg, SD, Min, Max
+    paper: Optional[Tuple[float, float, float, float]]  # Avg, SD, Min, Max; None: not a row of the paper
     note: str = ""
+    until: str = "stop_received"   # event that ends the reaction (a) and the wait
+    world: bool = False            # with the obstacle, laser and bumper (rubass.ros.sim.world)
+    behaviour: str = ""            # the behaviour whose start (b) is measured from; "": the first
 
 
 def _wheels(left: Dict[str, bool], right: Dict[str, bool]) -> Dict[str, Any]:
@@ -44,6 +47,16 @@ ROWS: List[Row] = [
         (0.17, 0.04, 0.11, 0.22)),
     Row("CPU", "kobuki", "kobuki.rbs", {"cpu_hog": 8.0, "threads": 2}, "cpu_hog_start", 1.50, (1.71, 0.14, 1.51, 1.95),
         note="(a) includes the node sampling period (10 Hz) and any CPU the loop is denied"),
+    # Beyond the paper: speed limits rather than stops (LANGUAGE.md §16, config/kobuki_creep.rbs)
+    Row("Creep", "kobuki", "kobuki_creep.rbs", {"goal": [1.5, -1.0]}, "obstacle_near", 0.00, None,
+        note="not in the paper: from the scan that first shows the obstacle within 0.8 m to the command clamped "
+             "to 0.1 m/s reaching the base", until="creep_received", world=True, behaviour="creep"),
+    Row("Back away", "kobuki", "kobuki_creep.rbs", {"goal": [1.5, -1.0]}, "bumper_pressed", 0.00, None,
+        note="not in the paper: from the bumper's contact to the first command that neither advances nor turns, "
+             "over the creep", until="escape_received", world=True, behaviour="escape"),
+    Row("Zone stop", "kobuki", "kobuki_creep.rbs", {"goal": [4.0, 0.0]}, "boundary", 0.00, None,
+        note="not in the paper: the zone's polygon border, the stop outranking the limits", world=True,
+        behaviour="zone_stop"),
 ]
 
 

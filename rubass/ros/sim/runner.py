@@ -100,7 +100,8 @@ def _spec_for(row: Row, run_dir: str) -> str:
 def _bag_topics(row: Row) -> List[str]:
     if row.robot == "kobuki":
         return ["/mobile_base/commands/velocity", "/odom", "/cmd_vel", "/mobile_base/commands/safety_velocity",
-                "/rubass/events", "/rubass/node_samples", "/sim/fault"]
+                "/rubass/events", "/rubass/node_samples", "/sim/fault"] + \
+            (["/scan", "/mobile_base/sensors/bumper"] if row.world else [])
     return ["/wheel_left/cmd", "/wheel_right/cmd", "/wheel_left/encoder", "/wheel_right/encoder", "/odom",
             "/wheel_left/safety_cmd", "/wheel_right/safety_cmd", "/rubass/events", "/sim/fault"]
 
@@ -137,6 +138,8 @@ def run_once(session: Session, row: Row, rep: int) -> RunResult:
     ev = f"_events_file:={events_file}"
     if row.robot == "kobuki":
         spawn("base", [PY, "-m", "rubass.ros.sim.kobuki", "__name:=mobile_base", ev])
+        if row.world:
+            spawn("world", [PY, "-m", "rubass.ros.sim.world", "__name:=world", ev])
         spawn("injector", [PY, "-m", "rubass.ros.sim.injector", "__name:=fault_injector", ev])
         spawn("driver", [PY, "-m", "rubass.ros.sim.driver", "__name:=controller", "_robot:=kobuki", ev,
                          "_goal_x:=2.5", "_goal_y:=1.0"])
@@ -171,7 +174,7 @@ def run_once(session: Session, row: Row, rep: int) -> RunResult:
         session.faults.publish(json.dumps(row.fault))
         fault_sent = time.time()
         end = fault_sent + STOP_TIMEOUT
-        while time.time() < end and not any(e["event"] == "stop_received" for e in read_events(events_file)):
+        while time.time() < end and not any(e["event"] == row.until for e in read_events(events_file)):
             time.sleep(0.01)
         time.sleep(0.3)  # let the recorder catch the last messages
         close_bag()
@@ -206,9 +209,9 @@ def _first(events: List[Dict[str, Any]], name: str, after: float = 0.0) -> Optio
 
 
 def _measure(row: Row, result: RunResult, spec_path: str, fault_sent: float) -> None:
-    stop = _first(result.events, "stop_received")
+    stop = _first(result.events, row.until)
     if stop is None:
-        result.error = f"no stop within {STOP_TIMEOUT:g} s of the fault"
+        result.error = f"no {row.until.replace('_', ' ')} within {STOP_TIMEOUT:g} s of the fault"
         return
     result.stopped = True
     origin = _first(result.events, row.origin, fault_sent - 1.0)
@@ -216,7 +219,7 @@ def _measure(row: Row, result: RunResult, spec_path: str, fault_sent: float) -> 
         result.error = f"no '{row.origin}' event"
         return
     result.a = stop - origin
-    due = _due_from_bag(spec_path, result.bag, fault_sent)
+    due = _due_from_bag(spec_path, result.bag, fault_sent, row.behaviour)
     result.due_source = "replay of the run's bag (with the monitor's node samples)"
     if due is None:
         result.error = "the replay of the bag found no behaviour start"
@@ -224,8 +227,9 @@ def _measure(row: Row, result: RunResult, spec_path: str, fault_sent: float) -> 
     result.b = stop - due
 
 
-def _due_from_bag(spec_path: str, bag_path: str, after: float) -> Optional[float]:
-    """The first behaviour start after `after`, as the engine computes it from the recording."""
+def _due_from_bag(spec_path: str, bag_path: str, after: float, behaviour: str = "") -> Optional[float]:
+    """The first start after `after` (of that behaviour, if named), as the engine computes it
+    from the recording."""
     spec = load_spec(spec_path)
     try:
         bag, info = open_bag(bag_path)
@@ -236,7 +240,9 @@ def _due_from_bag(spec_path: str, bag_path: str, after: float) -> Optional[float
         nodes = ["/rubass/node_samples"] if "/rubass/node_samples" in info.types else []
         decode = {t for t in topics if spec.topics[t].needs_data} | set(nodes)
         _, events = replay(spec, read(bag, topics + nodes, decode), info.start, info.end, node_topics=nodes)
-    starts = [info.start + e.time for e in events if e.kind == "start" and info.start + e.time >= after - 0.5]
+    wanted = spec.behaviour(behaviour).index if behaviour else None
+    starts = [info.start + e.time for e in events if e.kind == "start" and info.start + e.time >= after - 0.5
+              and wanted in (None, e.behaviour)]
     return min(starts) if starts else None
 
 
@@ -250,7 +256,7 @@ def results_json(rows: List[Row], results: List[RunResult]) -> Dict[str, Any]:
         sb = stats([x.b for x in runs if x.b is not None])
         out["rows"].append({
             "row": r.name, "robot": r.robot, "spec": r.spec, "ideal": r.ideal, "note": r.note,
-            "paper": dict(zip(("avg", "sd", "min", "max"), r.paper)),
+            "paper": dict(zip(("avg", "sd", "min", "max"), r.paper)) if r.paper else None,
             "a": asdict(sa) if sa else None, "b": asdict(sb) if sb else None,
             "runs": len(runs), "stopped": sum(x.stopped for x in runs),
             "errors": [x.error for x in runs if x.error],
