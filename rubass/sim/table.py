@@ -27,6 +27,8 @@ def print_table(data: Dict[str, Any], out: TextIO) -> bool:
     head = (f"{'row':<13} {'ideal':>5} | {'paper: avg':>10} {'sd':>5} {'min':>5} {'max':>5} | {'ours (a): avg':>13} {'sd':>5} "
             f"{'min':>5} {'max':>5} | {'(b) ms: avg':>11} {'sd':>5} {'min':>5} {'max':>5} {'p99':>5} | stopped")
     out.write(head + "\n" + "-" * len(head) + "\n")
+    if stop and not data["rows"]:
+        out.write("(no run finished)\n")
     for r in data["rows"]:
         a, b, p = r["a"] or {}, r["b"] or {}, r["paper"] or {}
         stopped = f"{r['stopped']}/{r['runs']}"
