@@ -231,6 +231,8 @@ class _Reader:
                 raise self.fail(t.at("values"), "with fields, give the values per field: fields: {PATH: VALUES}")
             fields = self.mapping(t["fields"], t.at("fields"), "fields", tuple(t["fields"] or ()))
             columns = [(k, v, fields.at(k), fields.at(k)) for k, v in fields.items()]
+            if not columns:
+                raise self.fail(t.at("fields"), f"the series of {topic} has no fields")
         steps: List[Tuple[Path, List[Any]]] = []
         for path_text, values, pline, vline in columns:
             try:
