@@ -25,5 +25,6 @@ for robot in kobuki frobit; do
     --hazards "config/${robot}_hazards.yaml" -o "out/report/$robot.html"
 done
 echo "evidence for a certifier (hazards, rules, tests, reaction; docs/report.md): $PWD/out/report/kobuki.html and $PWD/out/report/frobit.html"
+echo "  (after the experiments, add a run's timeline and explained stops: --bag out/experiments/runs/ROW/0/run.bag)"
 echo "== rubass experiments --reps ${REPS:-2} (quick mode)"
 exec $PY -m rubass experiments --reps "${REPS:-2}" --out out/experiments
