@@ -5,6 +5,7 @@ from dataclasses import dataclass, field
 from typing import List, Set, Tuple
 
 from ..lang.model import CheckedSpec
+from .runner import Outcome
 
 
 @dataclass
@@ -37,15 +38,15 @@ def behaviour_label(spec: CheckedSpec, index: int) -> str:
     return b.name if getattr(b, "name", "") else f"behaviour {index} (line {b.span.line})"
 
 
-def coverage(spec: CheckedSpec, outcomes: List["object"]) -> Coverage:
+def coverage(spec: CheckedSpec, outcomes: List[Outcome]) -> Coverage:
     """Coverage of one spec by the outcomes (runner.Outcome) of all tests that ran on it."""
     true: Set[str] = set()
     started: Set[int] = set()
     covers: Set[str] = set()
     for o in outcomes:
-        true |= o.rules_true  # type: ignore[attr-defined]
-        started |= o.started  # type: ignore[attr-defined]
-        covers |= set(o.covers)  # type: ignore[attr-defined]
+        true |= o.rules_true
+        started |= o.started
+        covers |= set(o.covers)
     ids, hazards = traced(spec)
     return Coverage(spec.path, len(outcomes),
                     [r.key for r in spec.rules if r.key not in true],
