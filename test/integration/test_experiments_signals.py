@@ -83,7 +83,7 @@ class Experiments:
         active = str(self.bag(rep)) + ".active"
         monitor_log = self.bag(rep).parent / "monitor.log"
         end = time.time() + timeout
-        while not (os.path.exists(active) and monitor_log.exists() and "enforcing" in monitor_log.read_text()):
+        while not (os.path.exists(active) and monitor_log.exists() and "rubass: enforcing" in monitor_log.read_text()):
             assert self.proc.poll() is None, f"exited {self.proc.returncode} before run {rep} was up\n{self.text()}"
             assert time.time() < end, f"run {rep} never came up\n{self.text()}"
             time.sleep(0.1)
