@@ -62,7 +62,7 @@ def test_limit_clamps_while_active_publishes_zero_after_timeout_and_nothing_whil
     first = between(rec, t_on, t_on + 1)[0]
     assert first["wall"] - t_on < 0.1 and first["msg"]["linear"]["x"] == 0.2
     # every command while active comes out clamped on the named axes, the others untouched
-    active = between(rec, mark(rec, "active"), mark(rec, "active") + 0.45)
+    active = between(rec, mark(rec, "active"), sent(rec, "/cmd_vel", 12) + 0.3)  # zeros only 0.5 s after the last
     assert len(active) == 7, active
     assert [m["msg"]["linear"]["x"] for m in active] == [0.2] * 6 + [0.05]
     assert [m["msg"]["angular"]["z"] for m in active] == [-0.5] * 6 + [0.3]
@@ -75,10 +75,10 @@ def test_limit_clamps_while_active_publishes_zero_after_timeout_and_nothing_whil
     assert 9 <= len(silence) <= 16  # 0.5 s of 1 s silence... at 20 Hz: ~14
     gaps = [b["wall"] - a["wall"] for a, b in zip(silence, silence[1:])]
     assert max(gaps) < 0.12 and sorted(gaps)[len(gaps) // 2] == pytest.approx(0.05, abs=0.01)
-    resumed = between(rec, mark(rec, "resume"), sent(rec, "/trig", 1))
-    assert resumed[0]["msg"]["linear"]["x"] == -0.1
-    assert all(m["msg"] == {"linear": ZERO, "angular": ZERO} for m in resumed[1:])  # 0.2 s: no timeout yet
-    assert len(resumed) == 1
+    resumed = between(rec, sent(rec, "/cmd_vel", 13), sent(rec, "/trig", 1))
+    first = next(i for i, m in enumerate(resumed) if m["msg"]["linear"]["x"] == -0.1)  # a zero may precede it
+    assert first <= 1 and resumed[first]["wall"] - sent(rec, "/cmd_vel", 13) < 0.1
+    assert len(resumed) == first + 1  # and no zero after it: 0.2 s is no timeout
     # released: nothing more, whatever comes in
     assert between(rec, sent(rec, "/trig", 1) + 0.05, 1e12) == []
 
@@ -101,9 +101,10 @@ def test_limit_on_twist_stamped_keeps_the_header(ros, tmp_path):
     assert all(m["msg"]["twist"]["linear"] == ZERO for m in at_start)
     assert all(m["msg"]["header"]["stamp"]["secs"] > 0 for m in at_start)  # stamped now
     after = between(rec, mark(rec, "cmd"), 1e12)
-    assert after[0]["msg"]["header"]["frame_id"] == "base_link"
-    assert after[0]["msg"]["twist"]["linear"]["x"] == 0.2 and after[0]["msg"]["twist"]["angular"]["z"] == 0.1
-    zeros = [m for m in after[1:] if m["wall"] - after[0]["wall"] > 0.25]
+    got = next(i for i, m in enumerate(after) if m["msg"]["header"]["frame_id"] == "base_link")
+    assert got <= 1 and after[got]["wall"] - sent(rec, "/cmd_vel") < 0.1  # a zero may just precede it
+    assert after[got]["msg"]["twist"]["linear"]["x"] == 0.2 and after[got]["msg"]["twist"]["angular"]["z"] == 0.1
+    zeros = [m for m in after[got + 1:] if m["wall"] - after[got]["wall"] > 0.25]
     assert zeros and all(m["msg"]["twist"]["linear"] == ZERO for m in zeros)
 
 

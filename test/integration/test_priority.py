@@ -39,9 +39,10 @@ def test_only_the_highest_priority_publishes_and_a_release_hands_over_without_ga
                                     sent(rec, "/lo_on", 1))
     assert set(xs(between(rec, lo_on, hi_on))) == {LO}
     during = between(rec, hi_on, hi_off)
-    assert during[0]["wall"] - hi_on < 0.1 and xs(during[:1]) == [HI]
-    assert set(xs(during)) == {HI}, xs(during)  # lo waits: not one of its messages while hi is active
-    assert 16 <= len(during) <= 23  # hi at 20 Hz for 1 s
+    switch = xs(during).index(HI)
+    assert switch <= 1 and during[switch]["wall"] - hi_on < 0.1, xs(during)  # one lo message in flight at most
+    assert set(xs(during[switch:])) == {HI}, xs(during)  # then lo waits: not one of its messages while hi is active
+    assert 15 <= len(during) <= 25  # hi at 20 Hz for 1 s
     after = between(rec, hi_off, lo_off)
     # handed over at once (lo's own period is 0.5 s), and nothing of hi once lo has the topic
     assert after[0]["wall"] - hi_off < 0.15, after[0]["wall"] - hi_off
@@ -50,7 +51,7 @@ def test_only_the_highest_priority_publishes_and_a_release_hands_over_without_ga
     # no gap longer than one period of the action that publishes (lo: 0.5 s; hi: 0.05 s), load allowing
     msgs = between(rec, lo_on, lo_off)
     gaps = [(b["wall"] - a["wall"], a["msg"]["linear"]["x"], b["msg"]["linear"]["x"]) for a, b in zip(msgs, msgs[1:])]
-    assert max(g for g, _, _ in gaps) < 0.5 + 0.1, gaps
+    assert max(g for g, _, _ in gaps) < 0.5 + 0.15, gaps
     assert max(g for g, x, y in gaps if x == y == HI) < 0.05 + 0.05, gaps
     assert between(rec, lo_off + 0.05, 1e12) == []
 
@@ -72,6 +73,7 @@ def test_a_stop_over_a_limit_then_the_limit_takes_over_with_fresh_commands(ros, 
         "steps": [{"wait_subscribers": "/cmd_vel"}, {"wait_subscribers": "/stop_on"},
                   {"wait_publishers": "/safety_cmd"}, {"sleep": 0.5},
                   {"publish": "/stop_on", "msg": {"data": 1.0}}, {"publish": "/crawl_on", "msg": {"data": 1.0}},
+                  {"sleep": 0.3},
                   {"publish": "/cmd_vel", "msg": {"linear": {"x": 1.0}}, "repeat": 10, "period": 0.05},
                   {"publish": "/stop_on", "msg": {"data": 0.0}},
                   {"publish": "/cmd_vel", "msg": {"linear": {"x": 1.0}}, "repeat": 10, "period": 0.05},
@@ -81,9 +83,11 @@ def test_a_stop_over_a_limit_then_the_limit_takes_over_with_fresh_commands(ros, 
     during = between(rec, on, off)
     assert len(during) >= 7 and all(m["msg"] == {"linear": ZERO, "angular": ZERO} for m in during), during
     after = between(rec, off, sent(rec, "/cmd_vel") + 0.01)
-    # the limit is heard at once with the latest command clamped: no zero of the stop after it
-    assert after[0]["wall"] - off < 0.05 and xs(after) == [0.2] * len(after), xs(after)
-    assert len(after) >= 10
+    # the limit is heard at once with the latest command clamped (one zero of the stop in flight at
+    # most), and no zero of the stop after it
+    back = xs(after).index(0.2)
+    assert back <= 1 and after[back]["wall"] - off < 0.1 and xs(after[back:]) == [0.2] * (len(after) - back), xs(after)
+    assert len(after) - back >= 10
 
 
 def test_one_priority_twice_on_one_topic_across_libraries_is_refused(ros, tmp_path):
@@ -94,3 +98,43 @@ def test_one_priority_twice_on_one_topic_across_libraries_is_refused(ros, tmp_pa
     out = refused(ros, path, f"_actions:=[{tmp_path / 'other.yaml'}]")
     assert (f"other.yaml:2:3: error: action 'brake': same priority (0) as action 'stop' ({tmp_path}/lib.yaml:2:3), "
             "and both publish on /safety_cmd") in out, out
+
+
+TWO_LIMITS = ("actions:\n"
+              "  back_away:\n    plugin: limit\n    input: /cmd_vel\n    topic: /safety_cmd\n"
+              "    linear_x: [-0.1 m/s, 0]\n    angular_z: [0, 0]\n    priority: 2\n"
+              "  crawl:\n    plugin: limit\n    input: /cmd_vel\n    topic: /safety_cmd\n"
+              "    linear_x: [-0.1 m/s, 0.2 m/s]\n    priority: 1\n")
+
+
+def test_two_limits_on_one_input_the_higher_clamps_and_its_release_hands_back_at_once(ros, tmp_path):
+    ros.monitor(limit_spec(tmp_path, TWO_LIMITS, "back_away, crawl",
+                           (("a", "/bump", "back_away"), ("b", "/near", "crawl"))))
+    f64 = "std_msgs/Float64"
+    cmd = {"linear": {"x": 1.0}, "angular": {"z": 0.4}}
+    rec = ros.probe({
+        "listen": [{"topic": "/safety_cmd", "type": TWIST}],
+        "advertise": [{"topic": "/cmd_vel", "type": TWIST}, {"topic": "/bump", "type": f64},
+                      {"topic": "/near", "type": f64}],
+        "steps": [{"wait_subscribers": "/cmd_vel"}, {"wait_subscribers": "/bump"}, {"wait_subscribers": "/near"},
+                  {"wait_publishers": "/safety_cmd"}, {"sleep": 0.5},
+                  {"publish": "/near", "msg": {"data": 1.0}},
+                  {"publish": "/cmd_vel", "msg": cmd, "repeat": 6, "period": 0.05},
+                  {"publish": "/bump", "msg": {"data": 1.0}},
+                  {"publish": "/cmd_vel", "msg": cmd, "repeat": 8, "period": 0.05},
+                  {"publish": "/bump", "msg": {"data": 0.0}},
+                  {"publish": "/cmd_vel", "msg": cmd, "repeat": 8, "period": 0.05}, {"sleep": 0.1}],
+        "linger": 0.1})
+    bump_on, bump_off = sent(rec, "/bump", 0), sent(rec, "/bump", 1)
+    before = between(rec, sent(rec, "/cmd_vel", 0), bump_on)
+    assert xs(before) == [0.2] * len(before) and len(before) >= 5
+    during = between(rec, bump_on, bump_off)
+    switch = next(i for i, m in enumerate(during) if m["msg"]["linear"]["x"] == 0.0)
+    assert during[switch]["wall"] - bump_on < 0.1 and switch <= 1, during  # a command crawl had in hand at most
+    assert len(during) - switch >= 6 and all(m["msg"]["linear"]["x"] == 0.0 and m["msg"]["angular"]["z"] == 0.0
+                                             for m in during[switch:]), during  # none of crawl's after the switch
+    after = between(rec, bump_off, 1e12)
+    back = next(i for i, m in enumerate(after) if m["msg"]["linear"]["x"] == 0.2)
+    assert after[back]["wall"] - bump_off < 0.1 and back <= 1, xs(after)  # a command back_away had in hand at most
+    assert xs(after[back:]) == [0.2] * (len(after) - back), xs(after)  # none of back_away's after the hand-over
+    assert after[back]["msg"]["angular"]["z"] == pytest.approx(0.4)
