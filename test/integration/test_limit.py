@@ -10,6 +10,7 @@ from rosharness import PY, TWIST
 pytestmark = [pytest.mark.ros, pytest.mark.slow]
 
 STAMPED = "geometry_msgs/TwistStamped"
+DIAG = "diagnostic_msgs/DiagnosticArray"
 ZERO = {"x": 0.0, "y": 0.0, "z": 0.0}
 
 
@@ -111,16 +112,21 @@ def test_limit_on_twist_stamped_keeps_the_header(ros, tmp_path):
 def test_a_mistyped_input_is_no_command_so_the_limit_publishes_zero_and_logs_why(ros, tmp_path):
     mon = ros.monitor(limit_spec(tmp_path, CRAWL))
     rec = ros.probe({
-        "listen": [{"topic": "/safety_cmd", "type": TWIST}],
+        "listen": [{"topic": "/safety_cmd", "type": TWIST}, {"topic": "/diagnostics", "type": DIAG}],
         "advertise": [{"topic": "/cmd_vel", "type": STAMPED}, {"topic": "/trig", "type": "std_msgs/Float64"}],
         "steps": [{"wait_subscribers": "/cmd_vel"}, {"wait_subscribers": "/trig"}, {"wait_publishers": "/safety_cmd"},
                   {"sleep": 0.5}, {"publish": "/trig", "msg": {"data": 1.0}},
-                  {"publish": "/cmd_vel", "msg": {"twist": {"linear": {"x": 3.0}}}, "repeat": 20, "period": 0.05}],
+                  {"publish": "/cmd_vel", "msg": {"twist": {"linear": {"x": 3.0}}}, "repeat": 20, "period": 0.05},
+                  {"sleep": 1.2}],
         "linger": 0.1})
-    got = between(rec, sent(rec, "/trig", 0), 1e12)
+    got = between(rec, sent(rec, "/trig", 0), sent(rec, "/cmd_vel") + 0.05)
     assert len(got) >= 10 and all(m["msg"] == {"linear": ZERO, "angular": ZERO} for m in got)
+    text = "/cmd_vel carries geometry_msgs/TwistStamped, not geometry_msgs/Twist"
     log = ros.log(mon)
-    assert "action 'crawl': /cmd_vel carries geometry_msgs/TwistStamped, not geometry_msgs/Twist" in log, log
+    assert f"action 'crawl': {text}" in log, log
+    last = [r for r in rec if r["kind"] == "recv" and r["topic"] == "/diagnostics"][-1]["msg"]
+    values = {v["key"]: v["value"] for st in last["status"] for v in st["values"]}
+    assert text in values.get("action crawl", ""), values
 
 
 @pytest.mark.parametrize("lib, message", [

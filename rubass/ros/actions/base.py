@@ -61,6 +61,7 @@ class ActionPlugin:
         self.name = action.name
         self.params = dict(action.params)
         self.active = False
+        self.stats = ActionStats()  # replaced by its runner's, which /diagnostics shows
 
     def setup(self) -> None:
         """Open publishers, ports, proxies; ActionSetupError for a configuration that cannot work."""

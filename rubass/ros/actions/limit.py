@@ -148,8 +148,11 @@ class LimitPlugin(ActionPlugin):
             return self.pub.get_num_connections()
 
     def _fail(self, text: str) -> None:
-        """A bad input is no command (the timeout turns it into zero): logged, at most every 5 s."""
+        """A bad input is no command (the timeout turns it into zero): counted in /diagnostics,
+        logged at most every 5 s."""
         self.input_errors += 1
+        self.stats.failures += 1
+        self.stats.last_error = f"input: {text}"
         now = time.monotonic()
         if now - self._last_log >= LOG_EVERY:
             self._last_log = now

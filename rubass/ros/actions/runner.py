@@ -33,6 +33,7 @@ class ActionRunner:
         self._last_log = 0.0
         self._thread: Optional[threading.Thread] = None
         plugin.wake = self.wake  # type: ignore[method-assign]
+        plugin.stats = self.stats  # a plugin may count failures of its own threads (limit: a bad input)
 
     @property
     def active(self) -> bool:
