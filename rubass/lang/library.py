@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import re
+import weakref
 from dataclasses import dataclass, field
 from typing import Any, Callable, Dict, Iterable, List, Optional, Tuple
 
@@ -211,7 +212,27 @@ def load_library(path: str, sources: SourceSet) -> Tuple[Dict[str, ActionDef], L
     if src is None:
         return {}, [diag] if diag else []
     sources.add(src)
-    return parse_library(src)
+    actions, diags = parse_library(src)
+    earlier = _LOADED.setdefault(sources, [])
+    clashes = _clashes(earlier, actions)
+    earlier.extend(a for a in actions.values() if a not in earlier)
+    return {k: a for k, a in actions.items() if a.span not in {d.span for d in clashes}}, diags + clashes
+
+
+# the actions of the libraries already loaded in one run (one SourceSet), for conflicts across them
+_LOADED: "weakref.WeakKeyDictionary[SourceSet, List[ActionDef]]" = weakref.WeakKeyDictionary()
+
+
+def _clashes(earlier: List[ActionDef], actions: Dict[str, ActionDef]) -> List[Diagnostic]:
+    """Priority conflicts of a library's actions with those of libraries loaded before it
+    (an action of the same name is another error, which the checker reports)."""
+    out = []
+    for a in actions.values():
+        for d in priority_conflicts([e for e in earlier if e.name != a.name and e.span.file != a.span.file] + [a]):
+            if d.span == a.span:
+                out.append(d)
+                break
+    return out
 
 
 _SAFE_TAGS = {"tag:yaml.org,2002:" + t for t in

@@ -148,3 +148,18 @@ def test_the_twist_mux_setup_in_docs_validates_and_its_spec_checks(tmp_path):
                       "entity base { rules: near: topic /scan_min.data < 0.5 m; bumped: topic /bumper.data > 0;\n"
                       "  outside: topic /odom.pose.pose.position.x > 10 m; }\n" + body, str(tmp_path / "s.rbs"))
     assert [b.actions[0].name for b in spec.behaviours] == ["crawl", "back_away", "stop"]
+
+
+def test_check_reports_one_priority_on_one_topic_across_two_libraries(tmp_path):
+    from rubass.lang import SpecError, check_text
+
+    (tmp_path / "a.yaml").write_text("actions:\n  stop:\n" + PUB + "    topic: /cmd\n")
+    (tmp_path / "b.yaml").write_text("actions:\n  # another team's library\n  brake:\n" + PUB + "    topic: /cmd\n"
+                                     "  slow:\n" + PUB + "    topic: /cmd\n    priority: 1\n")
+    with pytest.raises(SpecError) as info:
+        check_text('import "a.yaml";\nimport "b.yaml";\naction primitive stop, brake, slow;\n'
+                   "if (true) then { stop; brake; slow; }\n", str(tmp_path / "s.rbs"))
+    text = str(info.value)
+    assert text.startswith(f"{tmp_path}/b.yaml:3:3: error: action 'brake': same priority (0) as action 'stop' "
+                           f"({tmp_path}/a.yaml:2:3), and both publish on /cmd"), text
+    assert len(info.value.diagnostics) == 1  # slow (priority 1) is fine, and brake is not also "undefined"
