@@ -82,6 +82,7 @@ class LatchKeeper:
             self.report({"time": now, "event": "release", "behaviour": 0, "line": 0, "actions": list(latch.actions),
                          "rules": [], "cause": "reset service", "latency_ms": None})
         self.restored = []
+        self.problems = []  # the file is rewritten from the state now held
         return n
 
     def status(self) -> Dict[str, str]:

@@ -34,6 +34,7 @@ Signals
 from __future__ import annotations
 
 import os
+import queue
 import signal
 import sys
 import threading
@@ -176,6 +177,16 @@ class Monitor:
                      "~heartbeat (a watchdog fed by it stops the robot); fix the file, then SIGHUP or "
                      "rosservice call ~reload", error)
 
+    def _status_failed(self, exc: Exception) -> None:
+        """An ERROR status saying why the full one is missing (e.g. the engine's thread stalled)."""
+        why = "the engine's thread did not answer (stalled?)" if isinstance(exc, (queue.Empty, queue.Full)) \
+            else f"{exc.__class__.__name__}: {exc}"
+        try:
+            self.outputs.status([status_mod.Entry("rubass: monitor", status_mod.ERROR, f"STATUS UNAVAILABLE: {why}",
+                                                  [("spec", self.config.spec)])], _ros_now())
+        except Exception:  # publishing itself failed: the log line above is all there is
+            pass
+
     def _why_not(self) -> str:
         """Why the monitor is not enforcing (before its engine runs)."""
         if self.load_error:
@@ -295,8 +306,9 @@ class Monitor:
         while not rospy.is_shutdown() and not self._exit.is_set():
             try:
                 self.publish_status()
-            except Exception as exc:  # the status must never take the monitor down
-                rospy.logerr_throttle(10, f"rubass: status failed: {exc}")
+            except Exception as exc:  # the status must never take the monitor down, nor go silent
+                rospy.logerr_throttle(10, f"rubass: status failed: {exc.__class__.__name__}: {exc}")
+                self._status_failed(exc)
             self._exit.wait(period)
         self.shutdown()
         rospy.signal_shutdown("rubass monitor stopped")
@@ -407,7 +419,7 @@ class Monitor:
                 runner.adopt(prev)
         self.dispatcher.runners = runners
         self.loop.engine = new  # type: ignore[union-attr]
-        self.dispatcher.handle(new, events, "reload")
+        self._on_events(events, "reload")  # the latch state is written before a latched start is dispatched
         self.keeper.save(new, self.dispatcher.orphans, self._fail_safes())
 
     def reset(self) -> Tuple[bool, str]:
@@ -468,7 +480,6 @@ class Monitor:
                 monitor[f"action {name}"] = r.stats.last_error
         monitor.update(self.keeper.status())
         monitor["clock jumps back"] = loop.clock_jumps
-        monitor["last start"] = getattr(self.dispatcher, "last_start", "none")  # with its witnesses
         monitor["data errors"] = "; ".join(data_errors) or "none"
         if self.error_guard.active:
             monitor["data error actions"] = "running " + ", ".join(self.error_guard.actions)
