@@ -9,7 +9,7 @@ Each command is a geometry_msgs/Twist whose unclamped axes carry its sequence nu
 (angular.x, angular.y); linear.x = 1.0 comes out of the limit clamped to 0.2 (checked). The monitor
 also runs its engine (the limit is switched on by a rule). Added latency = path p50 - raw p50;
 target: added(limit) <= 1.5 x raw hop at p50. Prints one JSON object.
-Usage: bench/limit_latency.py [--samples N] [--hz HZ]
+Usage: bench/limit_latency.py [--samples N] [--hz HZ] [--smoke]
 """
 import argparse
 import json
@@ -118,8 +118,11 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--samples", type=int, default=2000, help="commands per path")
     ap.add_argument("--hz", type=float, default=150.0, help="commands per second, all paths together")
+    ap.add_argument("--smoke", action="store_true", help="a short run (50 commands per path), to check it works")
     ap.add_argument("--role", choices=("relay", "receiver", "sender"), help=argparse.SUPPRESS)
     args = ap.parse_args()
+    if args.smoke:
+        args.samples = 50
     if args.role == "relay":
         return relay()
     if args.role == "receiver":
@@ -155,7 +158,7 @@ def main() -> None:
     raw = res["raw"]["p50_ms"]
     added = {name: round(res[name]["p50_ms"] - raw, 3) for name in ("relay", "limit")}
     ratio = round(added["limit"] / raw, 2) if raw > 0 else None
-    print(json.dumps({"bench": "limit_latency", "samples_per_path": args.samples, "hz": args.hz, "paths": res,
+    print(json.dumps({"benchmark": "limit_latency", "samples_per_path": args.samples, "hz": args.hz, "paths": res,
                       "added_p50_ms": added, "limit_added_over_raw_hop_p50": ratio,
                       "target": "limit added <= 1.5 x raw hop at p50", "met": ratio is not None and ratio <= 1.5,
                       "clamped_wrong": out["wrong"], "lost": {n: args.samples - res[n]["n"] for n in res},
