@@ -157,3 +157,42 @@ def refused(ros, spec, *params):
     assert not [t for t, _ in state[1] if t in ("/trig", "/cmd_vel", "/a", "/b")], state
     assert not [t for t, _ in state[0] if t == "/safety_cmd"], state
     return out
+
+
+def test_a_reload_that_changes_a_limit_applies_the_new_range_without_a_gap_or_a_second_publisher(ros, tmp_path):
+    import signal
+
+    from rosharness import records
+
+    mon = ros.monitor(limit_spec(tmp_path, CRAWL))
+    cmd = {"linear": {"x": 1.0}}
+    trigger = ros.probe_bg({"advertise": [{"topic": "/trig", "type": "std_msgs/Float64"}],
+                            "steps": [{"wait_subscribers": "/trig"},
+                                      {"publish": "/trig", "msg": {"data": 1.0}, "repeat": 400, "period": 0.02}]},
+                           name="trigger")
+    listener = ros.probe_bg({
+        "listen": [{"topic": "/safety_cmd", "type": TWIST}],
+        "advertise": [{"topic": "/cmd_vel", "type": TWIST}],
+        "steps": [{"wait_subscribers": "/cmd_vel"}, {"wait_publishers": "/safety_cmd"}, {"sleep": 0.5},
+                  {"mark": "go"}, {"publish": "/cmd_vel", "msg": cmd, "repeat": 80, "period": 0.05}],
+        "linger": 0.1}, name="listener")
+    head = []
+    while '"go"' not in (head[-1] if head else ""):  # zeros come before: active, no command yet
+        head.append(listener.stdout.readline())
+        assert head[-1], head
+    time.sleep(1.0)
+    (tmp_path / "lib.yaml").write_text(CRAWL.replace("0.2 m/s]", "0.3 m/s]"))
+    time.sleep(0.1)
+    mon.send_signal(signal.SIGHUP)
+    out = records(listener)
+    trigger.kill()
+    assert "reloaded" in ros.log(mon), ros.log(mon)
+    got = [r for r in out if r["kind"] == "recv"]
+    got = got[[m["msg"]["linear"]["x"] for m in got].index(0.2):]  # from the first command's output on
+    xs = [m["msg"]["linear"]["x"] for m in got]
+    assert xs[0] == 0.2 and xs[-1] == 0.3, xs
+    switch = xs.index(0.3)
+    assert set(xs[:switch]) == {0.2} and set(xs[switch:]) == {0.3}, xs  # one range, then the other: no zero
+    assert 75 <= len(got) <= 82, len(got)  # one output per command: no second publisher, no zeros
+    gaps = [b["wall"] - a["wall"] for a, b in zip(got, got[1:])]
+    assert max(gaps) < 0.3, gaps

@@ -13,7 +13,7 @@ from __future__ import annotations
 import threading
 import time
 import warnings
-from typing import Any, Dict, Optional
+from typing import Any, Dict, Optional, Tuple
 
 import roslib.message
 import rospy
@@ -24,6 +24,9 @@ from .base import ActionPlugin, Context
 from .publish import ros_class
 
 LOG_EVERY = 5.0
+# the latest well-typed command on each input (resolved name): what came is a fact about the
+# topic, so a limit that a reload has just rebuilt starts from it, not from zero
+_LATEST: Dict[str, Tuple[bytes, float]] = {}
 
 
 class LimitPlugin(ActionPlugin):
@@ -51,6 +54,7 @@ class LimitPlugin(ActionPlugin):
             warnings.simplefilter("ignore")  # synchronous publisher on purpose, as in `publish`
             self.pub = rospy.Publisher(self.params["topic"], self.cls, queue_size=None, tcp_nodelay=True)
         self.seat = take_seat(self.params["topic"], self.name, self.action.priority, self._handed_over)
+        self.input = rospy.resolve_name(self.params["input"])
         self.sub = rospy.Subscriber(self.params["input"], rospy.AnyMsg, self._on_input, tcp_nodelay=True)
 
     # -- the subscriber's thread -----------------------------------------------------------
@@ -61,6 +65,7 @@ class LimitPlugin(ActionPlugin):
             self._fail(f"{self.params['input']} carries {got}, not {self.type} as action '{self.name}' says: "
                        f"its commands are ignored (so after {self.timeout:g} s it publishes zero)")
             return
+        _LATEST[self.input] = (raw._buff, now)
         with self._lock:
             if not self._on:  # decoded only if a start needs it
                 self._raw, self._raw_at = raw._buff, now
@@ -99,14 +104,14 @@ class LimitPlugin(ActionPlugin):
             self.seat.deactivate()
 
     def close(self) -> None:
-        with self._lock:
+        with self._lock:  # a command being published finishes first; none is published after
             self._on = False
+            endpoints, self.sub, self.pub = (self.sub, self.pub), None, None
         if self.seat is not None:
             self.seat.leave()
-        for endpoint in (self.sub, self.pub):
+        for endpoint in endpoints:
             if endpoint is not None:
                 endpoint.unregister()
-        self.sub = self.pub = None
 
     # -- helpers (under self._lock) ----------------------------------------------------------
     def _handed_over(self) -> None:
@@ -116,6 +121,9 @@ class LimitPlugin(ActionPlugin):
 
     def _current(self) -> Any:
         """The latest command clamped, if it came within `timeout`; else a zero command."""
+        shared = _LATEST.get(self.input)
+        if shared is not None and shared[1] > self._raw_at:
+            self._raw, self._raw_at = shared
         if self._raw is not None and time.monotonic() - self._raw_at <= self.timeout:
             msg = self._clamped(self._raw)
             if msg is not None:
