@@ -183,7 +183,7 @@ def scalar_paths(spec: CheckedSpec) -> Dict[str, Set[Tuple[ast.PathElem, ...]]]:
         if isinstance(expr, ast.TopicRef) and expr.path:
             out.setdefault(expr.topic, set()).add(expr.path)
         for e in ast.walk(expr):
-            if isinstance(e, ast.Call):
+            if isinstance(e, (ast.Call, ast.ArrayFn, ast.Quant)):  # arguments of functions, array terms
                 continue
             for child in ast.children(e):
                 if isinstance(child, ast.TopicRef) and child.path:
