@@ -459,8 +459,8 @@ class Monitor:
 
         rules, active, field_errors = loop.call(snapshot)
         data_errors = loop.call(self._data_errors)
-        topics = {s.spec_name: {"messages": s.messages, "errors": s.errors, "type": s.type}
-                  for s in self.watcher.status()}
+        topics = {name: {"messages": s.messages, "errors": s.errors, "type": s.type}
+                  for s in self.watcher.status() for name in (s.spec_name,) + s.aliases}  # every spelling
         nodes = {s.spec_name: {"why": s.why} for s in self.sampler.status.values()}
         failures = sum(r.stats.failures for r in self.runners.values())
         lat = sorted(self.dispatcher.latencies)
@@ -480,6 +480,8 @@ class Monitor:
                 monitor[f"action {name}"] = r.stats.last_error
         monitor.update(self.keeper.status())
         monitor["clock jumps back"] = loop.clock_jumps
+        if loop.dropped_by_topic:
+            monitor["dropped by topic"] = ", ".join(f"{t} {n}" for t, n in sorted(loop.dropped_by_topic.items()))
         monitor["data errors"] = "; ".join(data_errors) or "none"
         if self.error_guard.active:
             monitor["data error actions"] = "running " + ", ".join(self.error_guard.actions)

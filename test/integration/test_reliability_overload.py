@@ -25,6 +25,11 @@ def test_a_violation_last_in_a_burst_that_overflows_a_small_queue_is_still_stopp
     assert first(rec, "recv", "/safety_cmd") is not None, ros.log(mon)
     wait_log(mon, ros, "the newest message of each topic is kept")
     wait_log(mon, ros, "dropped so far: /x ")
+    rec = ros.probe({"listen": [{"topic": "/diagnostics", "type": "diagnostic_msgs/DiagnosticArray"}],
+                     "steps": [{"wait": "/diagnostics", "timeout": 5}]})
+    values = {kv["key"]: kv["value"] for s in first(rec, "recv", "/diagnostics")["msg"]["status"]
+              for kv in s["values"]}
+    assert values["dropped by topic"].startswith("/x "), values
     assert mon.poll() is None
 
 
