@@ -97,11 +97,10 @@ class CheckedSpec:
         owners = [(f"rule '{r.key}'", r.expr) for r in self.rules] + \
                  [(f"behaviour {b.index} (line {b.span.line})", b.cond) for b in self.behaviours]
         for owner, expr in owners:
-            for e in ast.walk(expr):
-                if isinstance(e, ast.TopicRef) and e.path:
-                    users = out[e.topic].setdefault(e.path, [])
-                    if owner not in users:
-                        users.append(owner)
+            for topic, path in _read_paths(expr):
+                users = out[topic].setdefault(path, [])
+                if owner not in users:
+                    users.append(owner)
         return out
 
     def behaviour(self, name: str) -> CheckedBehaviour:
@@ -116,3 +115,19 @@ class CheckedSpec:
             if r.key == key:
                 return r
         raise KeyError(key)
+
+
+def _read_paths(expr: ast.Expr) -> List[Tuple[str, Tuple[ast.PathElem, ...]]]:
+    """Every (topic, field path) an expression reads; an array term's element paths in full
+    (`status[*].level`), so they can be checked against the message type too."""
+    out: List[Tuple[str, Tuple[ast.PathElem, ...]]] = []
+    for e in ast.walk(expr):
+        if isinstance(e, ast.TopicRef) and e.path:
+            out.append((e.topic, e.path))
+        elif isinstance(e, ast.ArrayFn) and e.elem:
+            out.append((e.ref.topic, e.ref.path + e.elem))
+        elif isinstance(e, ast.StampAge):  # the message must be read for its stamp
+            out.append((e.topic, ("header", "stamp")))
+        elif isinstance(e, ast.Quant):
+            out += [(e.ref.topic, e.ref.path + x.path) for x in ast.walk(e.body) if isinstance(x, ast.Elem) and x.path]
+    return out

@@ -5,7 +5,7 @@ import re
 import sys
 from typing import Any, Optional, Tuple
 
-from ..lang.ast import PathElem
+from ..lang.ast import PathElem, Slice
 
 _ARRAY = re.compile(r"(.*)\[(\d*)\]$")
 _PRIMITIVES = {"bool", "int8", "uint8", "int16", "uint16", "int32", "uint32", "int64", "uint64",
@@ -37,14 +37,16 @@ def check_path(cls: Any, path: Tuple[PathElem, ...], scalar: bool = False) -> Op
     current: Optional[Any] = cls
     slot_type = type_name
     done = ""
-    for elem in path:
+    for i, elem in enumerate(path):
         m = _ARRAY.match(slot_type)
-        if isinstance(elem, int):
+        if isinstance(elem, (int, Slice)):
             if not m:
                 return f"'{done or type_name}' is not an array (it is {slot_type})"
+            if isinstance(elem, Slice) and i == len(path) - 1:
+                return None  # an array term (§12): its elements are read by min/max/len or a quantifier
             slot_type = m.group(1)
             current = None if slot_type in _PRIMITIVES else _message_class(slot_type, cls)
-            done += f"[{elem}]"
+            done += elem.text if isinstance(elem, Slice) else f"[{elem}]"
             continue
         if m:
             return f"'{done}' is an array ({slot_type}): index it, e.g. '{done}[0].{elem}'"
