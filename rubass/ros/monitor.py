@@ -356,6 +356,11 @@ class Monitor:
                     raise StartupError(f"{spec.path}: the new spec has no behaviours; refusing to drop every "
                                        f"safety behaviour of the running spec (was the file caught half-written? "
                                        f"to run without rules, restart the monitor)")
+                gone = [n for n, r in self.runners.items()
+                        if n not in spec.actions and r.active and self.spec.actions[n].latch]
+                if gone:  # actions are carried by name: a latched one that is on cannot just vanish
+                    raise StartupError(f"{spec.path}: the new spec no longer declares {', '.join(gone)}, which is "
+                                       f"latched and active; call ~reset first (or keep the action's name)")
                 runners = self._runners(spec, self.runners)
             except (SpecError, StartupError) as exc:
                 text = exc.render() if isinstance(exc, SpecError) else str(exc)

@@ -132,3 +132,19 @@ def test_a_broken_spec_at_start_is_named_in_diagnostics_and_a_sighup_after_the_f
                      "steps": [{"wait_subscribers": "/x"}, {"sleep": 0.3}, {"publish": "/x", "msg": {"data": 5.0}},
                                {"wait": "/safety_cmd", "timeout": 3}]})
     assert [r for r in rec if r["kind"] == "recv"], ros.log(mon)
+
+
+def test_a_reload_that_would_drop_a_latched_active_action_is_rejected_and_the_stop_goes_on(ros, tmp_path):
+    path = spec(tmp_path, BODY)
+    mon = ros.monitor(path)
+    trigger_and_clear(ros)
+    (tmp_path / "lib.yaml").write_text(LIB.replace("  stop:", "  halt:"))
+    (tmp_path / "s.rbs").write_text('import "lib.yaml";\naction primitive halt, brake, warn;\n'
+                                    + BODY.replace("stop", "halt"))
+    time.sleep(0.1)
+    out = ros.call("/rubass/reload")
+    assert "no longer declares stop, which is latched and active" in out.stdout, out.stdout
+    assert len(stops_within(ros, 1.0)) >= 10, "the latched stop goes on"
+    assert ros.call("/rubass/reset").returncode == 0
+    out = ros.call("/rubass/reload")
+    assert "reloaded" in out.stdout, out.stdout
