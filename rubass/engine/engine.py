@@ -12,7 +12,7 @@ from __future__ import annotations
 import heapq
 import itertools
 from dataclasses import dataclass
-from typing import Any, Dict, Iterable, List, Optional, Set, Tuple
+from typing import Any, Dict, FrozenSet, Iterable, List, Optional, Set, Tuple
 
 from ..lang import ast
 from ..lang.model import CheckedBehaviour, CheckedSpec
@@ -41,7 +41,8 @@ class Event:
 class _Node:
     """One rule or behaviour of the evaluation graph."""
 
-    __slots__ = ("key", "compiled", "behaviour", "active", "value", "actions", "users", "pushed")
+    __slots__ = ("key", "compiled", "behaviour", "active", "value", "actions", "users", "pushed",
+                 "volatile", "slots", "inputs", "fresh")
 
     def __init__(self, key: str, compiled: Compiled, behaviour: Optional[CheckedBehaviour]) -> None:
         self.key, self.compiled, self.behaviour = key, compiled, behaviour
@@ -50,6 +51,15 @@ class _Node:
         self.actions: Tuple[str, ...] = tuple(a.name for a in behaviour.actions) if behaviour else ()
         self.users: Set[int] = set()
         self.pushed: Dict[int, float] = {}  # id(op) -> the deadline already in the heap
+        # Incremental evaluation after a message: a node that is not `volatile` is a function of
+        # the fields it reads (`slots`) and of the values of other nodes (`inputs`) alone, so it
+        # is skipped when none of those changed. Volatile: stateful operators (for, within,
+        # latch, crossings: each evaluation counts), time (age, frequency, stamp_age, rate),
+        # node samples, active(), laser limits.
+        self.volatile = True
+        self.slots: FrozenSet[Any] = frozenset()  # field slots while planning, then their numbers
+        self.inputs: FrozenSet[int] = frozenset()
+        self.fresh = True  # never evaluated yet
 
     @property
     def checked(self) -> Optional[CheckedBehaviour]:
@@ -95,10 +105,22 @@ class Engine:
         self._stamped: Set[str] = set()
         self._laser: Set[str] = set()
         readers: Dict[str, List[int]] = {}  # action -> nodes that read active(action)
+        inputs: List[Set[int]] = [set() for _ in self._nodes]
+        self._slot_ids: Dict[Tuple[str, Tuple[ast.PathElem, ...]], int] = {}  # field slot -> its number
         for i, node in enumerate(self._nodes):
             expr = node.behaviour.cond if node.behaviour else spec.rule(node.key).expr
             topics, nodes = set(), set()
+            slots: Set[Tuple[str, Tuple[ast.PathElem, ...]]] = set()
+            volatile = bool(node.compiled.ops)
             for e in ast.walk(expr):
+                if isinstance(e, (ast.Age, ast.Frequency, ast.StampAge, ast.NodeStat, ast.Rate, ast.Active)):
+                    volatile = True
+                elif isinstance(e, ast.ArrayFn) and e.ref.path[:1] == ("ranges",):
+                    volatile = True  # reads the scan's range limits too
+                if isinstance(e, ast.TopicRef):
+                    slots.add((e.topic, e.path))
+                elif isinstance(e, ast.RuleRef):
+                    inputs[i].add(self._at[e.key])
                 if isinstance(e, ast.TopicRef):
                     topics.add(e.topic)
                 elif isinstance(e, (ast.Age, ast.Frequency, ast.StampAge)):
@@ -123,6 +145,7 @@ class Engine:
                 timed.append(i)
             topics_of.append(topics)
             nodes_of.append(nodes)
+            node.volatile, node.slots, node.inputs = volatile, frozenset(slots), frozenset(inputs[i])
         for node in self._nodes:
             for action in node.actions:
                 node.users.update(readers.get(action, ()))
@@ -131,6 +154,12 @@ class Engine:
             self.store.watch(topic, now, windows.get(topic, 0.0))
         self._paths = {t: tuple(sorted((p for p in u.paths if p != STAMP), key=str))  # rate fields too
                        for t, u in spec.topics.items()}
+        # per topic: (slot number, store slot, its cell, path, its key in field_errors), computed once
+        self._reads = {t: tuple((self._slot_ids.setdefault((t, p), len(self._slot_ids)), (t, p),
+                                 self.store.cell((t, p)), p, str(p)) for p in paths)
+                       for t, paths in self._paths.items()}
+        for node in self._nodes:
+            node.slots = frozenset(self._slot_ids.setdefault(s, len(self._slot_ids)) for s in node.slots)
         self._topic_plans = {t: self._plan([i for i, s in enumerate(topics_of) if t in s]) for t in spec.topics}
         self._node_plans = {n: self._plan([i for i, s in enumerate(nodes_of) if n in s]) for n in spec.nodes}
         self._tick_plan = self._plan(timed)
@@ -159,28 +188,34 @@ class Engine:
         topic updated, the other not yet) and could restart a `for`.
         """
         events = self.advance(now, inclusive=False)
+        changed: Set[int] = set()  # the numbers of the field slots whose value changed
         if isinstance(items, tuple) and len(items) == 1:  # the live case: one message, its own plan
             topic, msg = items[0]
-            self._store_message(topic, now, msg)
+            self._store_message(topic, now, msg, changed)
             plan = self._topic_plans.get(topic)
             if plan:
-                self._run(plan, events)
+                self._run(plan, events, changed)
             events += self.advance(now)
             return events
         seeds: Set[int] = set()
         for topic, msg in items:
-            self._store_message(topic, now, msg)
+            self._store_message(topic, now, msg, changed)
             seeds.update(self._topic_plans.get(topic, ()))
         if seeds:
-            self._run(tuple(sorted(seeds)), events)
+            self._run(tuple(sorted(seeds)), events, changed)
         events += self.advance(now)
         return events
 
-    def _store_message(self, topic: str, now: float, msg: Any) -> None:
+    def _store_message(self, topic: str, now: float, msg: Any, changed: Set[Any]) -> None:
         store = self.store
         store.arrive(topic, now)
-        for path in self._paths.get(topic, ()):
-            store.fields[(topic, path)] = self._read(topic, path, msg)
+        fields = store.fields
+        for number, slot, cell, path, key in self._reads.get(topic, ()):
+            value = self._read(topic, path, msg, key)
+            old = cell[0]
+            if value is not old and (value != old or type(value) is not type(old)):
+                changed.add(number)
+                cell[0] = fields[slot] = value
         for path in self._rate_paths.get(topic, ()):  # read above, as a plain field
             store.arrive_rate(topic, path, now, store.fields.get((topic, path), UNKNOWN))
         if topic in self._stamped:
@@ -192,16 +227,17 @@ class Engine:
         if topic in self._laser:
             store.laser_limits[topic] = _laser_limits(msg)
 
-    def _read(self, topic: str, path: Tuple[ast.PathElem, ...], msg: Any) -> Any:
+    def _read(self, topic: str, path: Tuple[ast.PathElem, ...], msg: Any, key: str) -> Any:
         if msg is UNKNOWN:  # the shell could not read it: its fields are missing data
             return UNKNOWN
         try:
             value = extract(msg, path)
-            self.field_errors.pop((topic, str(path)), None)
-            return value
         except FieldError as exc:
-            self.field_errors[(topic, str(path))] = str(exc)
+            self.field_errors[(topic, key)] = str(exc)
             return UNKNOWN
+        if self.field_errors:
+            self.field_errors.pop((topic, key), None)
+        return value
 
     def on_node_sample(self, node: str, now: float, alive: Any, cpu: Any = UNKNOWN, memory: Any = UNKNOWN) -> List[Event]:
         """A sample of a node: alive True/False/UNKNOWN, cpu share of a core, memory bytes."""
@@ -323,6 +359,7 @@ class Engine:
             else:
                 dst.watch_start[topic] = now
         dst.fields.update({k: v for k, v in src.fields.items() if k[0] in self.spec.topics})
+        dst.sync_cells()
         dst.nodes.update({n: v for n, v in src.nodes.items() if n in self.spec.nodes})
         dst.now = max(dst.now, now)
         old_rules = {n.key: n for n in old._nodes if not n.behaviour}
@@ -387,11 +424,18 @@ class Engine:
         return Event(self.store.now, kind, b.index, actions=node.actions, line=b.span.line, name=b.name,
                      witness=witness)
 
-    def _run(self, plan: Tuple[int, ...], events: List[Event]) -> None:
+    def _run(self, plan: Tuple[int, ...], events: List[Event], changed: Optional[Set[Any]] = None) -> None:
+        """Evaluate the plan's nodes in order. After a message (`changed`: the field slots it
+        changed), a node that is not volatile is skipped when neither a field it reads nor a
+        node it reads changed value: it would give the value it has."""
         store, nodes = self.store, self._nodes
-        changed = False
+        moved: Set[int] = set()  # nodes whose value changed in this run
         for i in plan:
             node = nodes[i]
+            if changed is not None and not node.volatile and not node.fresh \
+                    and changed.isdisjoint(node.slots) and moved.isdisjoint(node.inputs):
+                continue
+            node.fresh = False
             value = node.compiled.fn()
             if node.compiled.ops:
                 self._schedule(i, node)
@@ -401,24 +445,24 @@ class Engine:
                 old = store.rules.get(key, UNKNOWN)
                 if value is not old and value != old or key not in store.rules:
                     store.rules[key] = value
+                    moved.add(i)
                     events.append(Event(store.now, "rule", rule=key, value=None if value is UNKNOWN else value))
                 continue
+            if value is not node.value:  # True, False or UNKNOWN
+                moved.add(i)
             node.value = value
             if value is True and not node.active:
                 node.active = True
                 for a in node.actions:
                     self._holders.setdefault(a, set()).add(node.key)
-                changed = True
                 self._sync_actions()
                 events.append(self._event(node, "start", self.explain(b.index)))
             elif value is not True and node.active and not b.latched:
                 node.active = False
                 for a in node.actions:
                     self._holders.get(a, set()).discard(node.key)
-                changed = True
                 self._sync_actions()
                 events.append(self._event(node, "release"))
-        del changed
 
     def _schedule(self, idx: int, node: _Node) -> None:
         for due, op in node.compiled.deadlines():

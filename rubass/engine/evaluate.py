@@ -65,8 +65,8 @@ class Compiler:
             rules, key = store.rules, e.key
             return lambda: rules.get(key, UNKNOWN)
         if isinstance(e, ast.TopicRef):
-            fields, slot = store.fields, (e.topic, e.path)
-            return lambda: fields.get(slot, UNKNOWN)
+            cell = store.cell((e.topic, e.path))
+            return lambda: cell[0]
         if isinstance(e, ast.Unary):
             inner, op1 = self._fn(e.operand, ops, cell), UNARY[e.op]
             return lambda: op1(inner())
@@ -130,7 +130,7 @@ class Compiler:
             if e.ref.path[:1] == ("ranges",) and len(e.ref.path) <= 2 and not e.elem:
                 laser, topic = store.laser_limits, e.ref.topic
                 limits = lambda: laser.get(topic)  # noqa: E731
-            return array_fn(e.func, read, e.elem, limits)
+            return _kept(array_fn(e.func, read, e.elem, limits), read, limits)
         if isinstance(e, ast.Quant):
             slot: List[Any] = [None]
             body = self._fn(e.body, ops, slot)
@@ -155,3 +155,19 @@ class Compiler:
                 return float(measure(px, py, poly)) if measure is boundary_distance else measure(px, py, poly)
             return zone
         raise TypeError(f"cannot evaluate {type(e).__name__}")
+
+
+def _kept(fn: Fn, read: Fn, limits: Optional[Fn]) -> Fn:
+    """min/max/len of an array term, kept with the array it was computed from: the array is
+    immutable (a tuple or bytes that each message replaces), so evaluating the term again
+    before its topic's next message (another topic's message, a deadline) costs no pass over it."""
+    last: List[Any] = [None, None, None]  # the array, the laser limits, the value
+
+    def apply() -> Any:
+        arr, lim = read(), (limits() if limits is not None else None)
+        if arr is last[0] and lim == last[1] and arr is not None:
+            return last[2]
+        value = fn()
+        last[0], last[1], last[2] = arr, lim, value
+        return value
+    return apply

@@ -7,6 +7,7 @@ in benchmarks, a manual one in tests), and events are handed to a callback.
 from __future__ import annotations
 
 import dataclasses
+import math
 import queue
 import threading
 from dataclasses import dataclass
@@ -45,11 +46,21 @@ class Call:
 
 
 class EngineLoop:
-    """Owns an engine; `submit` from any thread, `run` on one."""
+    """Owns an engine; `submit` from any thread, `run` on one.
+
+    With `inline`, the thread that submits an input handles it at once when the engine is free
+    (under the engine's lock, in queue order), rather than waking the engine's thread for each
+    message: that thread then only wakes for deadlines and ticks, and for what queued up while
+    another thread held the engine. Everything the engine does still happens under one lock, in
+    the order inputs were queued. `on_error` gets what an input handled inline raised.
+    """
+
+    BURST = 256  # inputs one submitting thread handles before it leaves the rest to the engine's thread
 
     def __init__(self, engine: Engine, clock: Callable[[], float], rate: float, handler: Handler,
                  max_queue: int = 100000, tick_hook: Optional[Callable[[float], None]] = None,
-                 max_bytes: int = 256 * 1024 * 1024, on_clock_jump: Optional[JumpHook] = None) -> None:
+                 max_bytes: int = 256 * 1024 * 1024, on_clock_jump: Optional[JumpHook] = None,
+                 inline: bool = False, on_error: Optional[Callable[[Exception], None]] = None) -> None:
         self.engine = engine
         self.clock = clock
         self.period = 1.0 / rate
@@ -74,6 +85,11 @@ class EngineLoop:
         self.jump_tolerance = max(0.25, 2 * self.period)
         self._last_clock = clock()
         self.clock_jumps = 0
+        self.inline = inline
+        self.on_error = on_error
+        self._engine_lock = threading.Lock()  # held while anything runs the engine (inline mode)
+        self._wake = threading.Event()  # inline mode: an earlier deadline, or inputs left over
+        self._sleep_until = math.inf  # when the engine's thread wakes next by itself
 
     # -- any thread ----------------------------------------------------------------------
     def submit(self, item: Any) -> bool:
@@ -88,7 +104,6 @@ class EngineLoop:
                 self.queued_bytes += size
         try:
             self.inbox.put_nowait(item)
-            return True
         except queue.Full:
             self._unqueue(size)
             if isinstance(item, Message):
@@ -97,6 +112,29 @@ class EngineLoop:
             else:
                 self.dropped += 1
             return False
+        if self.inline:
+            self._pump()
+        return True
+
+    def _pump(self) -> None:
+        """Inline mode: handle what is queued, if no other thread is handling it already."""
+        lock, pending = self._engine_lock, self.inbox.queue
+        while pending and lock.acquire(False):
+            handled = 0
+            try:
+                handled = self._drain(self.BURST)
+                deadline = self.engine.next_deadline()
+                if handled >= self.BURST or (deadline is not None and deadline < self._sleep_until):
+                    self._wake.set()  # the engine's thread goes on, or wakes earlier than it meant to
+            except Exception as exc:
+                if self.on_error is None:
+                    raise
+                self.on_error(exc)
+            finally:
+                lock.release()
+            if handled >= self.BURST:
+                return
+            # an input queued while we held the lock, whose thread could not take it, is ours
 
     def _conflate(self, item: "Message") -> None:
         """Under _bytes_lock: keep `item` as its topic's newest; the one it replaces is dropped."""
@@ -113,6 +151,8 @@ class EngineLoop:
         """Run fn on the engine's thread and wait for its result (its exception is re-raised)."""
         done: "queue.Queue[Tuple[bool, Any]]" = queue.Queue(maxsize=1)
         self.inbox.put(Call(fn, done), timeout=timeout)
+        if self.inline:
+            self._pump()
         ok, value = done.get(timeout=timeout)
         if not ok:
             raise value
@@ -120,6 +160,7 @@ class EngineLoop:
 
     def stop(self) -> None:
         self._stop.set()
+        self._wake.set()
         try:
             self.inbox.put_nowait(None)
         except queue.Full:
@@ -132,6 +173,33 @@ class EngineLoop:
 
     def step(self, max_wait: Optional[float] = None) -> None:
         """Wait for an input or the next wake-up, then handle everything that is due."""
+        if self.inline:
+            with self._engine_lock:
+                timeout = self._wait_for(max_wait)
+                self._sleep_until = self._last_clock + timeout
+            if timeout > 0 and not self.inbox.queue and not self._newest:
+                self._wake.wait(timeout)
+            self._wake.clear()
+            with self._engine_lock:
+                self._sleep_until = -math.inf  # awake: a submitting thread need not wake it
+                self._drain(self.BURST)
+                self._due()
+            return
+        timeout = self._wait_for(max_wait)
+        try:
+            item = self.inbox.get(timeout=timeout) if timeout > 0 else self.inbox.get_nowait()
+        except queue.Empty:
+            item = None
+        if item is not None:
+            self._handle(item)
+        if self._newest:
+            self._handle_newest()
+        elif self._applied and self.inbox.empty():
+            self._applied.clear()  # every message queued before those has been handled
+        self._due()
+
+    def _wait_for(self, max_wait: Optional[float]) -> float:
+        """How long to wait for an input before the next wake-up (a clock jump is handled here)."""
         now = self.clock()
         if now < self._last_clock - self.jump_tolerance:
             self._clock_jumped(now)
@@ -145,16 +213,27 @@ class EngineLoop:
         timeout = max(0.0, wake - now)
         if max_wait is not None:
             timeout = min(timeout, max_wait)
-        try:
-            item = self.inbox.get(timeout=timeout) if timeout > 0 else self.inbox.get_nowait()
-        except queue.Empty:
-            item = None
-        if item is not None:
-            self._handle(item)
+        return timeout
+
+    def _drain(self, limit: Optional[int]) -> int:
+        """Handle up to `limit` queued inputs (all, if None) in queue order, then the conflated newest."""
+        get, handled = self.inbox.get_nowait, 0
+        while limit is None or handled < limit:
+            try:
+                item = get()
+            except queue.Empty:
+                break
+            if item is not None:
+                self._handle(item)
+                handled += 1
         if self._newest:
             self._handle_newest()
-        elif self._applied and self.inbox.empty():
+        elif self._applied and not self.inbox.queue:
             self._applied.clear()  # every message queued before those has been handled
+        return handled
+
+    def _due(self) -> None:
+        """The deadlines that are due, and the tick."""
         now = self.clock()
         deadline = self.engine.next_deadline()
         if deadline is not None and deadline <= now:

@@ -23,6 +23,21 @@ class Store:
         self.rates: Dict[Tuple[str, Tuple[PathElem, ...]], Any] = {}
         self._rate_last: Dict[Tuple[str, Tuple[PathElem, ...]], Tuple[float, Any]] = {}
         self.laser_limits: Dict[str, Optional[Tuple[float, float]]] = {}
+        # field slot -> [its value], the same as in `fields`: what compiled expressions read (a
+        # key with a slice in its path costs a Python-level hash at every dict lookup)
+        self._cells: Dict[Tuple[str, Tuple[PathElem, ...]], List[Any]] = {}
+
+    def cell(self, slot: Tuple[str, Tuple[PathElem, ...]]) -> List[Any]:
+        """The one-element list that always holds the slot's value (UNKNOWN until one is stored)."""
+        c = self._cells.get(slot)
+        if c is None:
+            c = self._cells[slot] = [self.fields.get(slot, UNKNOWN)]
+        return c
+
+    def sync_cells(self) -> None:
+        """After `fields` was written directly (a live reload carrying values over)."""
+        for slot, c in self._cells.items():
+            c[0] = self.fields.get(slot, UNKNOWN)
 
     def watch(self, topic: str, now: float, window: float = 0.0) -> None:
         """Start watching a topic (age counts from here); keep arrivals for `window` seconds."""

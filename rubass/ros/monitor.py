@@ -66,7 +66,7 @@ from .errorguard import ErrorGuard
 from .keeper import LatchKeeper
 from .latches import LatchFile, default_path
 from .params import MonitorConfig, ParamError, read_config
-from .topics import TopicWatcher
+from .topics import TopicWatcher, ros_now
 
 
 class StartupError(Exception):
@@ -82,7 +82,7 @@ def _log(level: str, text: str) -> None:
 
 
 def _ros_now() -> float:
-    return rospy.get_rostime().to_sec()
+    return ros_now()
 
 
 class Monitor:
@@ -229,8 +229,14 @@ class Monitor:
         self.keeper.restore(spec.actions, runners, _ros_now())  # before the first tick
         now = self._first_time()
         engine = Engine(spec, now)
+        # inline: a message is evaluated on the thread that received it when the engine is free
+        # (no hand-off to the engine's thread per message; issue 17)
         self.loop = EngineLoop(engine, _ros_now, self.config.rate, self._on_events,
-                               max_queue=self.config.queue_size, tick_hook=self._tick, on_clock_jump=self.clock_jump)
+                               max_queue=self.config.queue_size, tick_hook=self._tick, on_clock_jump=self.clock_jump,
+                               inline=True, on_error=self._engine_error)
+        hold = getattr(engine, "hold_actions", None)  # an engine that knows outside holders: active(a) sees them
+        for latch in self.keeper.restored if hold is not None else []:
+            self._on_events(hold(latch.actions, f"restored: {latch.holder}", now), "reload")
         self._on_events(engine.evaluate_all(now), "reload")
         self.keeper.save(engine, self.dispatcher.orphans, self._fail_safes())
         self.watcher = TopicWatcher(self._on_message, _log)
@@ -312,6 +318,11 @@ class Monitor:
             self._exit.wait(period)
         self.shutdown()
         rospy.signal_shutdown("rubass monitor stopped")
+
+    @staticmethod
+    def _engine_error(exc: Exception) -> None:
+        """A bug met while evaluating inline, on a subscriber's thread: logged, and enforcement goes on."""
+        rospy.logerr_throttle(1, f"rubass: engine step failed: {exc.__class__.__name__}: {exc}")
 
     def _engine_thread(self) -> None:
         loop = self.loop

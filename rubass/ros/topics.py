@@ -19,6 +19,16 @@ from ..lang import ast
 from ..lang.model import CheckedSpec
 from .msgtypes import check_path
 
+_rostime = rospy.rostime
+
+
+def ros_now() -> float:
+    """rospy.get_rostime() in seconds; on the wall clock without building a rospy.Time each time."""
+    if _rostime._rostime_current is None and _rostime._rostime_initialized:
+        return time.time()
+    return _rostime.get_rostime().to_sec()
+
+
 Submit = Callable[[str, float, Any, float, int], None]  # (spec topic, ROS time, message or None, wall, bytes)
 Log = Callable[[str, str], None]
 
@@ -93,8 +103,8 @@ class TopicWatcher:
             self.topics.clear()
 
     def _callback(self, raw: Any, state: TopicState) -> None:
-        now = rospy.get_rostime().to_sec()
         wall = time.time()
+        now = wall if _rostime._rostime_current is None and _rostime._rostime_initialized else ros_now()
         state.messages += 1
         if not state.paths:
             self.submit(state.spec_name, now, None, wall, 0)  # age/frequency only: never deserialised
