@@ -10,11 +10,12 @@ from __future__ import annotations
 import math
 from typing import Any, Tuple
 
+from ..lang.errors import RubassError
 from ..lang.ast import PathElem, Slice, path_suffix
 from .values import UNKNOWN
 
 
-class FieldError(Exception):
+class FieldError(RubassError):
     """A field path that does not exist in the message's type (a spec/type mismatch)."""
 
 

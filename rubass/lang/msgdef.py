@@ -6,6 +6,8 @@ import re
 from dataclasses import dataclass
 from typing import Dict, Iterable, List, Optional, Tuple
 
+from .errors import RubassError
+
 PRIMITIVES = {"bool", "int8", "uint8", "int16", "uint16", "int32", "uint32", "int64", "uint64",
               "float32", "float64", "string", "time", "duration", "char", "byte"}
 INTEGERS = {"int8": (-2 ** 7, 2 ** 7 - 1), "uint8": (0, 2 ** 8 - 1), "int16": (-2 ** 15, 2 ** 15 - 1),
@@ -16,7 +18,7 @@ _FIELD = re.compile(r"([A-Za-z_][A-Za-z0-9_/]*)(\[(\d*)\])?\s+([A-Za-z_][A-Za-z0
 _SEPARATOR = re.compile(r"^={10,}\s*$", re.M)
 
 
-class DefinitionError(ValueError):
+class DefinitionError(RubassError, ValueError):
     """A definition that cannot be parsed; the message names the type and the line."""
 
 

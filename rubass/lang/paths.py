@@ -6,10 +6,12 @@ import re
 import xml.etree.ElementTree as ET
 from typing import Dict, Iterable, Mapping, Optional
 
+from .errors import RubassError
+
 _PACKAGE_URL = re.compile(r"package://([^/]+)/(.*)")
 
 
-class PathError(Exception):
+class PathError(RubassError):
     """An import path that cannot be resolved; the message says why."""
 
 

@@ -8,6 +8,7 @@ from typing import Any, Dict, List, Optional, Sequence, Set
 
 import yaml
 
+from ..lang.errors import RubassError
 from ..engine import Event
 from ..lang import ast
 from ..lang.model import CheckedSpec
@@ -17,7 +18,7 @@ from ..testing.runner import Outcome
 from .bench import Reaction
 
 
-class ReportError(Exception):
+class ReportError(RubassError):
     """An input of the report that cannot be used; the message says which and why."""
 
 

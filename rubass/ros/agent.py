@@ -32,6 +32,7 @@ from urllib.parse import urlparse
 
 import psutil
 
+from ..lang.errors import RubassError
 from ..engine.values import UNKNOWN
 from ..lang.units import FREQUENCY, parse_quantity
 from . import rpc
@@ -41,7 +42,7 @@ from .nodes import NodeSampler, NodeStatus
 Log = Callable[[str, str], None]
 
 
-class AgentParamError(Exception):
+class AgentParamError(RubassError):
     """A bad parameter of the agent; the message names it."""
 
 

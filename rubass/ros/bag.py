@@ -7,8 +7,10 @@ from typing import Any, Dict, Iterator, List, Optional, Set, Tuple
 
 import rosbag
 
+from ..lang.errors import RubassError
 
-class BagError(Exception):
+
+class BagError(RubassError):
     """A recording that cannot be read; the message says why, in one line."""
 
 

@@ -8,6 +8,7 @@ import os
 import socket
 from typing import Dict, Optional
 
+from ..lang.errors import RubassError
 from ..lang.msgdef import DefinitionError, Registry
 from ..lang.std_units import joint_state_units, urdf_joint_kinds
 from ..lang.sysmodel import SystemModel
@@ -18,7 +19,7 @@ from .rpc import proxy as rpc_proxy
 CALLER = "/rubass_check"
 
 
-class LiveError(Exception):
+class LiveError(RubassError):
     """The live graph cannot be read (no master, …); the message says why, in one line."""
 
 

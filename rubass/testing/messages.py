@@ -10,6 +10,8 @@ import math
 import re
 from typing import Any, Dict, List, Optional, Tuple
 
+from ..lang.errors import RubassError
+
 _ARRAY = re.compile(r"(.*)\[(\d*)\]$")
 _INTS = {"int8", "uint8", "int16", "uint16", "int32", "uint32", "int64", "uint64", "char", "byte"}
 _FLOATS = {"float32", "float64"}
@@ -18,7 +20,7 @@ _PATH = re.compile(r"([A-Za-z_][A-Za-z0-9_]*)|\[(-?\d+)\]|(\.)")
 Path = Tuple[Any, ...]
 
 
-class MessageError(ValueError):
+class MessageError(RubassError, ValueError):
     """A type that is not installed, or a field or value the type does not allow."""
 
 

@@ -9,6 +9,7 @@ from __future__ import annotations
 import re
 from typing import Any, List
 
+from ..lang.errors import RubassError
 from ..lang.units import parse_quantity
 
 GAP: Any = object()  # a step with no message
@@ -20,7 +21,7 @@ _REPEAT = re.compile(r"(.+)x(\d+)")
 _MAX_STEPS = 10_000_000
 
 
-class SeriesError(ValueError):
+class SeriesError(RubassError, ValueError):
     """A word of a series that is not one of the forms; the message says which and why."""
 
 

@@ -5,8 +5,10 @@ from typing import Any, Dict, List
 
 import yaml
 
+from ..lang.errors import RubassError
 
-class TestFileError(Exception):
+
+class TestFileError(RubassError):
     """A test file that cannot be run; rendered `FILE:LINE: error: MESSAGE`."""
 
     def __init__(self, path: str, line: int, message: str) -> None:
