@@ -95,7 +95,8 @@ def human(spec: CheckedSpec, events: List[Event], end: float, out: TextIO) -> No
                 for reading in witness.readings:
                     out.write(f"{'':14}{reading.text()}\n")
         elif e.kind == "release":
-            out.write(f"{e.time:10.3f} s  release  behaviour {e.behaviour} (line {e.line})\n")
+            name = f" {e.name}" if getattr(e, "name", "") else ""
+            out.write(f"{e.time:10.3f} s  release  behaviour {e.behaviour}{name} (line {e.line})\n")
     rules, behaviours = summarise(spec, events, end)
     width = max([len(k) for k in rules] + [4])
     out.write(f"\nrules over {end:.3f} s:\n")
@@ -103,6 +104,7 @@ def human(spec: CheckedSpec, events: List[Event], end: float, out: TextIO) -> No
     for key, s in rules.items():
         out.write(f"  {key:<{width}}  {s.true:>9.3f}s  {s.false:>9.3f}s  {s.unknown:>9.3f}s  {s.became_true:>11}\n")
     out.write("behaviours:\n")
+    names = {x.index: f" {x.name}" if x.name else "" for x in spec.behaviours}
     for index, b in behaviours.items():
-        out.write(f"  {index}. line {b.line} ({', '.join(b.actions) or 'no actions'}): fired {b.fired} time"
+        out.write(f"  {index}.{names.get(index, '')} line {b.line} ({', '.join(b.actions) or 'no actions'}): fired {b.fired} time"
                   f"{'s' if b.fired != 1 else ''}, active {b.active:.3f} s\n")

@@ -79,6 +79,10 @@ class Dispatcher:
             "actions": [a.name for a in b.actions], "rules": list(rules), "cause": source,
             "latency_ms": None if latency is None else round(latency * 1000.0, 3),
         }
+        if b.name:  # starts and releases alike carry the behaviour's name and attributes (§14, §15)
+            record["name"] = b.name
+        if b.attrs:
+            record["attrs"] = {k: list(v) for k, v in b.attrs.items()}
         witness = getattr(e, "witness", None)
         if witness is not None:  # why it started: name, attributes, true rules and the values they read
             record.update(witness.as_json())

@@ -1,4 +1,6 @@
 """Language version 2 in the live monitor (issue 12): the same engine as replay, on real topics."""
+import json
+
 import pytest
 
 from rosharness import TWIST, first, spec
@@ -17,7 +19,8 @@ def test_a_laser_sector_stops_and_active_escalates_by_name(ros, tmp_path):
                      "entity field { rules: obstacle: min(topic /scan.ranges[0:3]) < 0.4 m; }\n"
                      "obstacle_stop: if (field.obstacle) then { stop; }\n"
                      "escalate: if (active(stop) for 0.3 s) then { brake; }\n"))
-    rec = ros.probe({"listen": [{"topic": "/safety_cmd", "type": TWIST}, {"topic": "/brake", "type": "std_msgs/Bool"}],
+    rec = ros.probe({"listen": [{"topic": "/safety_cmd", "type": TWIST}, {"topic": "/brake", "type": "std_msgs/Bool"},
+                                {"topic": "/rubass/events", "type": "std_msgs/String"}],
                      "advertise": [{"topic": "/scan", "type": SCAN}],
                      "steps": [{"wait_subscribers": "/scan"}, {"wait_publishers": "/safety_cmd"},
                                {"wait_publishers": "/brake"}, {"sleep": 0.3},
@@ -32,6 +35,9 @@ def test_a_laser_sector_stops_and_active_escalates_by_name(ros, tmp_path):
     assert stop["wall"] > sent[1]["wall"]  # not on the first scan: an empty sector is unknown, not an obstacle
     assert stop["wall"] - sent[1]["wall"] < 0.2
     assert brake["wall"] - stop["wall"] == pytest.approx(0.3, abs=0.08)  # active(stop) for 0.3 s
+    events = [json.loads(r["msg"]["data"]) for r in rec if r["kind"] == "recv" and r["topic"] == "/rubass/events"]
+    assert [(e["event"], e.get("name")) for e in events] == [("start", "obstacle_stop"), ("start", "escalate")]
+    assert events[0]["witnesses"] == {"min(/scan.ranges[0:3])": pytest.approx(0.35)}  # float32 ranges
 
 
 def test_stale_stamps_and_a_diagnostics_quantifier(ros, tmp_path):

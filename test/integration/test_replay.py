@@ -172,3 +172,18 @@ def test_type_misuse_is_rejected_at_its_line(write, tmp_path, rule, words):  # i
     proc = replay(spec, bag)
     assert proc.returncode == 1 and proc.stdout == ""
     assert f"{spec}:3:" in proc.stderr and words in proc.stderr and "^" in proc.stderr, proc.stderr
+
+
+def test_named_behaviours_are_named_in_starts_releases_and_the_summary(write, tmp_path):  # issue 12
+    bag = write_bag(str(tmp_path / "b.bag"), [(0.0, "/cmd_vel", twist(2.0)), (2.0, "/cmd_vel", twist(0.0))])
+    spec = spec_file(write, '@id("SR-1") entity base { rules: fast: topic /cmd_vel.linear.x > 1.0 m/s; }\n'
+                            '@hazard("H1") overspeed: if (base.fast) then { warn; }\n')
+    proc = replay(spec, bag)
+    assert proc.returncode == 0, proc.stderr
+    assert "     0.000 s  start    behaviour 1 overspeed (line 4): warn" in proc.stdout
+    assert "@hazard: H1" in proc.stdout
+    assert "     2.000 s  release  behaviour 1 overspeed (line 4)" in proc.stdout
+    assert "  1. overspeed line 4 (warn): fired 1 time" in proc.stdout
+    events = [json.loads(x) for x in replay(spec, bag, "--json").stdout.splitlines()]
+    assert [(e["event"], e.get("name")) for e in events if e.get("event") in ("start", "release")] == \
+        [("start", "overspeed"), ("release", "overspeed")]
