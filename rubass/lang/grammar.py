@@ -404,13 +404,11 @@ def parse_source(source: Source) -> ast.Spec:
         except RecursionError:
             loc, depth = _deepest(text)
             raise _error(source, loc, f"expressions are nested too deeply to parse ({depth} parentheses "
-                                      f"deep here; at most about {MAX_NESTING} are supported)") from None
+                                      "deep here; about 50 parse: flatten it, and/or chains of any length "
+                                      "need no parentheses)") from None
         finally:
             _ctx.source = None
     return ast.Spec(tuple(toks), tuple(comments), file=source.name)
-
-
-MAX_NESTING = 40  # parentheses inside one expression that pyparsing parses within Python's stack
 
 
 def _deepest(text: str) -> Tuple[int, int]:
