@@ -118,7 +118,7 @@ def test_two_limits_on_one_input_the_higher_clamps_and_its_release_hands_back_at
                       {"topic": "/near", "type": f64}],
         "steps": [{"wait_subscribers": "/cmd_vel"}, {"wait_subscribers": "/bump"}, {"wait_subscribers": "/near"},
                   {"wait_publishers": "/safety_cmd"}, {"sleep": 0.5},
-                  {"publish": "/near", "msg": {"data": 1.0}},
+                  {"publish": "/near", "msg": {"data": 1.0}}, {"sleep": 0.3},  # crawl's start: zero, no command yet
                   {"publish": "/cmd_vel", "msg": cmd, "repeat": 6, "period": 0.05},
                   {"publish": "/bump", "msg": {"data": 1.0}},
                   {"publish": "/cmd_vel", "msg": cmd, "repeat": 8, "period": 0.05},
