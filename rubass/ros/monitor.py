@@ -49,6 +49,7 @@ from std_srvs.srv import Trigger, TriggerResponse
 from ..engine import Engine
 from ..engine.loop import EngineLoop, Message, NodeSample
 from ..lang import SpecError, load_spec
+from ..lang.library import priority_conflicts
 from ..lang.model import CheckedSpec
 from . import status as status_mod
 from .actions.base import ActionSetupError, make_plugin
@@ -110,6 +111,7 @@ class Monitor:
         except SpecError as exc:
             raise StartupError(exc.render()) from None
         self._check_overload_actions(spec)
+        self._check_priorities(spec)
         self._check_library_types(spec)
         for w in spec.warnings:
             rospy.logwarn("rubass: %s", w.render(spec.sources))
@@ -124,6 +126,13 @@ class Monitor:
         if missing:
             raise ConfigError(f"{spec.path}: ~error_actions names {', '.join(missing)}, which the spec does not "
                               f"declare (add 'action primitive {', '.join(missing)};')")
+
+    @staticmethod
+    def _check_priorities(spec: CheckedSpec) -> None:
+        """Two actions of one priority on one topic (§16), across libraries, names resolved."""
+        conflicts = priority_conflicts(spec.actions.values(), rospy.resolve_name)
+        if conflicts:
+            raise StartupError("\n".join(d.render(spec.sources) for d in conflicts))
 
     @staticmethod
     def _check_library_types(spec: CheckedSpec) -> None:
@@ -354,6 +363,7 @@ class Monitor:
             try:
                 spec = self._load_stable()
                 self._check_overload_actions(spec)
+                self._check_priorities(spec)
                 self._check_library_types(spec)
                 t_check = time.monotonic()
                 if self.spec is not None and self.loop is None:
