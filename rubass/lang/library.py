@@ -12,6 +12,7 @@ from .errors import Diagnostic, did_you_mean
 from .grammar import KEYWORDS
 from .source import Source, SourceSet, Span
 from .units import FREQUENCY, SPEED, TIME, Dimension, dim, dimension_name, parse_quantity
+from .yamltags import foreign_tags
 
 BUILTIN_PLUGINS = ("publish", "serial", "service", "log", "limit")
 CUSTOM_PLUGIN_RE = re.compile(r"[A-Za-z_][A-Za-z0-9_]*(?:\.[A-Za-z_][A-Za-z0-9_]*)*:[A-Za-z_][A-Za-z0-9_]*")
@@ -235,29 +236,6 @@ def _clashes(earlier: List[ActionDef], actions: Dict[str, ActionDef]) -> List[Di
     return out
 
 
-_SAFE_TAGS = {"tag:yaml.org,2002:" + t for t in
-              ("str", "int", "float", "bool", "null", "seq", "map", "binary", "timestamp", "set", "omap", "pairs",
-               "merge", "value")}
-
-
-def _foreign_tags(root: yaml.Node) -> List[yaml.Node]:
-    """Nodes whose tag a safe loader cannot build (python/object, custom '!tags'): never built,
-    but reported as an error rather than a loader traceback. Each node once: alias bombs are DAGs."""
-    seen, out, todo = set(), [], [root]
-    while todo:
-        node = todo.pop()
-        if id(node) in seen:
-            continue
-        seen.add(id(node))
-        if node.tag not in _SAFE_TAGS:
-            out.append(node)
-        if isinstance(node, yaml.MappingNode):
-            todo += [n for pair in node.value for n in pair]
-        elif isinstance(node, yaml.SequenceNode):
-            todo += list(node.value)
-    return sorted(out, key=lambda n: n.start_mark.index)
-
-
 def parse_library(src: Source) -> Tuple[Dict[str, ActionDef], List[Diagnostic]]:
     """Validate library text already read; positions point into src."""
     diags: List[Diagnostic] = []
@@ -273,7 +251,7 @@ def parse_library(src: Source) -> Tuple[Dict[str, ActionDef], List[Diagnostic]]:
     top = Span(src.name, 1, 1)
     if not isinstance(root, yaml.MappingNode):
         return {}, [Diagnostic(top, "an action library must be a mapping with a key 'actions'")]
-    foreign = _foreign_tags(root)
+    foreign = foreign_tags(root)
     if foreign:
         return {}, [Diagnostic(_Node(n, src.name).span, f"YAML tag '{n.tag}' is not allowed: an action library "
                                                         f"holds plain data only (strings, numbers, booleans, "

@@ -11,27 +11,10 @@ from .msgdef import TYPE_RE, DefinitionError, parse_msg
 from .source import Source, SourceSet, Span
 from .sysmodel import SystemModel
 from .units import DIMENSIONLESS, UNITS, Dimension
+from .yamltags import PLAIN_TAGS, foreign_tags
 
 KEYS = ("rubass_model", "source", "topics", "nodes", "units", "definitions")
 TOPIC_RE = re.compile(r"/?[A-Za-z_][A-Za-z0-9_]*(?:/[A-Za-z_][A-Za-z0-9_]*)*/?")
-_PLAIN_TAGS = {"tag:yaml.org,2002:" + t for t in ("str", "int", "float", "bool", "null", "seq", "map")}
-
-
-def _foreign_tags(root: yaml.Node) -> List[yaml.Node]:
-    """Nodes a safe loader would refuse or turn into objects (each node once: aliases are a DAG)."""
-    seen, out, todo = set(), [], [root]
-    while todo:
-        node = todo.pop()
-        if id(node) in seen:
-            continue
-        seen.add(id(node))
-        if node.tag not in _PLAIN_TAGS:
-            out.append(node)
-        if isinstance(node, yaml.MappingNode):
-            todo += [n for pair in node.value for n in pair]
-        elif isinstance(node, yaml.SequenceNode):
-            todo += list(node.value)
-    return sorted(out, key=lambda n: n.start_mark.index)
 
 
 def _span(node: yaml.Node, file: str) -> Span:
@@ -103,7 +86,7 @@ def parse_model(src: Source) -> Tuple[Optional[SystemModel], List[Diagnostic]]:
     r = _Reader(src.name)
     if not isinstance(root, yaml.MappingNode):
         return None, [Diagnostic(Span(src.name, 1, 1), "a system model must be a mapping with a key 'topics'")]
-    foreign = _foreign_tags(root)
+    foreign = foreign_tags(root, PLAIN_TAGS)
     if foreign:
         return None, [Diagnostic(_span(n, src.name), f"YAML tag '{n.tag}' is not allowed: a system model holds "
                                                      "plain data only") for n in foreign]
