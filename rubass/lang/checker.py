@@ -274,7 +274,7 @@ class _Checker:
 
     def _broken_in_library(self, name: str) -> bool:
         """True when a library defines `name` but its definition had errors (already reported)."""
-        return any(d.message.startswith(f"action '{name}':") for d in self.diags)
+        return any(d.subject == name for d in self.diags)
 
     def check_behaviours(self, declared: Dict[str, Span], library: Dict[str, ActionDef]) -> List[CheckedBehaviour]:
         out: List[CheckedBehaviour] = []

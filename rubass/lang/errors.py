@@ -17,6 +17,8 @@ class Diagnostic:
     severity: str = "error"
     # the source line, for a file that could not be read as text (so it is in no SourceSet)
     line_text: str = field(default="", compare=False)
+    # what it is about, for code that must know without reading the text: an action's name
+    subject: str = field(default="", compare=False)
 
     def render(self, sources: Optional[SourceSet] = None) -> str:
         """Compiler-style text: header, the source line, a caret under the column."""

@@ -1,6 +1,7 @@
 """Action libraries (LANGUAGE.md §8): YAML files validated key by key, errors with places."""
 from __future__ import annotations
 
+import dataclasses
 import re
 import weakref
 from dataclasses import dataclass, field
@@ -231,7 +232,7 @@ def _clashes(earlier: List[ActionDef], actions: Dict[str, ActionDef]) -> List[Di
     for a in actions.values():
         for d in priority_conflicts([e for e in earlier if e.name != a.name and e.span.file != a.span.file] + [a]):
             if d.span == a.span:
-                out.append(d)
+                out.append(dataclasses.replace(d, subject=a.name))
                 break
     return out
 
@@ -277,11 +278,13 @@ def parse_library(src: Source) -> Tuple[Dict[str, ActionDef], List[Diagnostic]]:
             diags.append(Diagnostic(kspan, f"action '{name}' is defined twice in this library"))
             continue
         action, problems = _action(name, kspan, _Node(vnode, src.name), src.name)
-        diags.extend(problems)
+        diags.extend(dataclasses.replace(d, subject=name) for d in problems)
         if action is not None:
             out[name] = action
-    conflicts = priority_conflicts(out.values())
-    for d in conflicts:
+    conflicts = []
+    for d in priority_conflicts(out.values()):
+        names = [k for k, v in out.items() if v.span == d.span]
+        conflicts.append(dataclasses.replace(d, subject=names[0] if names else ""))
         out = {k: v for k, v in out.items() if v.span != d.span}
     return out, diags + conflicts
 
