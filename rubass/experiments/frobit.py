@@ -26,8 +26,8 @@ from typing import Dict
 import rospy
 from std_msgs.msg import Float64, Header
 
-from ...sim.faults import WheelFault
-from ...sim.kinematics import DiffDrive
+from .faults import WheelFault
+from .kinematics import DiffDrive
 from .common import loop, odometry, on_fault
 from .eventlog import EventLog
 

@@ -12,7 +12,7 @@ import sys
 from dataclasses import asdict
 from typing import TYPE_CHECKING, Any, Dict, List
 
-from ...sim.rows import ROWS, Row, row
+from .rows import ROWS, Row, row
 from .procs import Interrupted, Supervisor
 
 if TYPE_CHECKING:
@@ -55,7 +55,7 @@ def run(args: argparse.Namespace) -> int:
 
 
 def _run(rows: List[Row], reps: int, out: str, sup: Supervisor) -> int:
-    from ...sim.table import plot, print_table
+    from .table import plot, print_table
     from .runner import main_loop, results_json
 
     print(f"rubass experiments: {len(rows)} rows x {reps} runs; results in {out}", file=sys.stderr)

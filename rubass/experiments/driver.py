@@ -17,7 +17,7 @@ from geometry_msgs.msg import Twist
 from nav_msgs.msg import Odometry
 from std_msgs.msg import Float64
 
-from ...sim.kinematics import DiffDrive, go_to_goal
+from .kinematics import DiffDrive, go_to_goal
 from .common import loop, on_fault, yaw_of
 from .eventlog import EventLog
 

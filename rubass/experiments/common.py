@@ -9,7 +9,7 @@ import rospy
 from nav_msgs.msg import Odometry
 from std_msgs.msg import String
 
-from ...sim.kinematics import DiffDrive
+from .kinematics import DiffDrive
 
 FAULT_TOPIC = "/sim/fault"
 

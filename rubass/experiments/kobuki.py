@@ -17,7 +17,7 @@ import rospy
 from geometry_msgs.msg import Twist
 from sensor_msgs.msg import JointState
 
-from ...sim.kinematics import DiffDrive
+from .kinematics import DiffDrive
 from .common import loop, odometry
 from .eventlog import EventLog
 

@@ -12,7 +12,7 @@ import time
 import rospy
 from geometry_msgs.msg import Twist
 
-from ...sim.faults import Drift
+from .faults import Drift
 from .common import on_fault
 from .eventlog import EventLog
 

@@ -1,1 +1,0 @@
-"""The simulated robots, the fault injector and the experiment runner (ROS nodes)."""
