@@ -23,6 +23,8 @@ import sys
 import tempfile
 import time
 
+import psutil
+
 import _common
 from _rosbench import PY, PrivateMaster, start_monitor, stop_processes
 
@@ -99,6 +101,19 @@ def _cpu(pid):
     return 0.0 if v is None else v
 
 
+def _detail(pid):
+    """(user s, system s, context switches) of a process, all its threads."""
+    t = psutil.Process(pid).cpu_times()
+    switches = 0
+    for tid in os.listdir(f"/proc/{pid}/task"):
+        try:
+            with open(f"/proc/{pid}/task/{tid}/status") as fh:
+                switches += sum(int(line.split()[1]) for line in fh if "ctxt_switches" in line)
+        except (OSError, ValueError, IndexError):
+            continue  # a thread that just exited
+    return t.user, t.system, switches
+
+
 def run_case(master, tmp, profile, spec, scale, seconds):
     """One run: monitor and bare subscriber together, publishing at `scale` x the profile's rates."""
     bare = pub = mon = None
@@ -113,6 +128,7 @@ def run_case(master, tmp, profile, spec, scale, seconds):
         for line in pub.stdout:
             if line.startswith("start"):
                 t0, c0 = time.monotonic(), (_cpu(mon.pid), _cpu(bare.pid))
+                d0 = (_detail(mon.pid), _detail(bare.pid))
             elif line.startswith("{"):
                 done = json.loads(line)
                 break
@@ -120,6 +136,7 @@ def run_case(master, tmp, profile, spec, scale, seconds):
             raise SystemExit("the publisher did not run: " + open(os.path.join(tmp, "pub.log")).read()[-2000:])
         time.sleep(0.3)  # what is still queued is handled (its CPU belongs to the window)
         t1, c1 = time.monotonic(), (_cpu(mon.pid), _cpu(bare.pid))
+        d1 = (_detail(mon.pid), _detail(bare.pid))
         pub.wait(10)
     finally:
         stop_processes([p for p in (pub, mon) if p is not None])
@@ -138,6 +155,9 @@ def run_case(master, tmp, profile, spec, scale, seconds):
         "ratio": round(mon_cpu / bare_cpu, 2) if bare_cpu > 0 else None,
         "monitor_cpu_share": round(mon_cpu / (t1 - t0), 3), "bare_cpu_share": round(bare_cpu / (t1 - t0), 3),
         "monitor_received": mon_rx, "monitor_dropped": mon_drop, "bare_received": bare_rx,
+        # where the CPU goes: user and system time (syscalls, wake-ups), and context switches, per message
+        **{f"{who}_{what}_per_msg": round((d1[k][j] - d0[k][j]) / n * (1e6 if j < 2 else 1), 1 if j < 2 else 2)
+           for k, who in enumerate(("monitor", "bare")) for j, what in enumerate(("user_us", "system_us", "ctx_switches"))},
         "monitor_lost": None if mon_rx is None else n - mon_rx + mon_drop,
         "bare_lost": None if bare_rx is None else n - bare_rx,
     }

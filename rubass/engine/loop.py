@@ -95,6 +95,23 @@ class EngineLoop:
     def submit(self, item: Any) -> bool:
         """Queue an input; False if the queue is full, by count or by bytes: then a message is kept
         as its topic's newest (conflation) and the one it replaces, if any, is counted as dropped."""
+        if self.inline and not self.inbox.queue and not self._newest and self._engine_lock.acquire(False):
+            done = False
+            try:
+                if not self.inbox.queue and not self._newest:  # nothing waits before it: no queue
+                    done = True
+                    self._handle(item, queued=False)
+                    self._wake_if_sooner()
+            except Exception as exc:
+                if self.on_error is None:
+                    raise
+                self.on_error(exc)
+            finally:
+                self._engine_lock.release()
+            if done:
+                if self.inbox.queue:
+                    self._pump()  # queued by others meanwhile
+                return True
         size = item.size if isinstance(item, Message) else 0
         if size:
             with self._bytes_lock:
@@ -123,9 +140,10 @@ class EngineLoop:
             handled = 0
             try:
                 handled = self._drain(self.BURST)
-                deadline = self.engine.next_deadline()
-                if handled >= self.BURST or (deadline is not None and deadline < self._sleep_until):
-                    self._wake.set()  # the engine's thread goes on, or wakes earlier than it meant to
+                if handled >= self.BURST:
+                    self._wake.set()  # the engine's thread goes on
+                else:
+                    self._wake_if_sooner()
             except Exception as exc:
                 if self.on_error is None:
                     raise
@@ -135,6 +153,12 @@ class EngineLoop:
             if handled >= self.BURST:
                 return
             # an input queued while we held the lock, whose thread could not take it, is ours
+
+    def _wake_if_sooner(self) -> None:
+        """Under the engine's lock: wake its thread if the engine's next deadline is now sooner."""
+        deadline = self.engine.next_deadline()
+        if deadline is not None and deadline < self._sleep_until:
+            self._wake.set()
 
     def _conflate(self, item: "Message") -> None:
         """Under _bytes_lock: keep `item` as its topic's newest; the one it replaces is dropped."""
@@ -266,12 +290,13 @@ class EngineLoop:
             self._applied[m.topic] = m.time
             self._emit(self.engine.on_message(m.topic, m.time, m.msg), m)
 
-    def _handle(self, item: Any) -> None:
+    def _handle(self, item: Any, queued: bool = True) -> None:
         if self.clock_jumps and isinstance(item, (Message, NodeSample)) and \
                 item.time > self._last_clock + self.jump_tolerance:
             item = dataclasses.replace(item, time=self.clock())  # stamped on the old timeline, before the jump
         if isinstance(item, Message):
-            self._unqueue(item.size)
+            if queued:
+                self._unqueue(item.size)
             if self._applied and item.time <= self._applied.get(item.topic, float("-inf")):
                 return  # older than a newer message of its topic already handled (conflated)
             self._emit(self.engine.on_message(item.topic, item.time, item.msg), item)
