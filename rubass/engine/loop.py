@@ -115,10 +115,15 @@ class EngineLoop:
         size = item.size if isinstance(item, Message) else 0
         if size:
             with self._bytes_lock:
-                if self.queued_bytes + size > self.max_bytes:
+                over = self.queued_bytes + size > self.max_bytes
+                if over:
                     self._conflate(item)
-                    return False
-                self.queued_bytes += size
+                else:
+                    self.queued_bytes += size
+            if over:
+                if self.inline:
+                    self._pump()
+                return False
         try:
             self.inbox.put_nowait(item)
         except queue.Full:
@@ -128,6 +133,8 @@ class EngineLoop:
                     self._conflate(item)
             else:
                 self.dropped += 1
+            if self.inline:
+                self._pump()  # what is queued, then the newest of each topic
             return False
         if self.inline:
             self._pump()
