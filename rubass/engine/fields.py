@@ -8,7 +8,8 @@ one copy, not one conversion per element; the array functions (min, max, len) sk
 from __future__ import annotations
 
 import math
-from typing import Any, Tuple
+import operator
+from typing import Any, Callable, Dict, Tuple
 
 from ..lang.errors import RubassError
 from ..lang.ast import PathElem, Slice, path_suffix
@@ -23,24 +24,47 @@ def path_text(path: Tuple[PathElem, ...]) -> str:
     return path_suffix(path).lstrip(".")
 
 
+# (message class, path of field names) -> a C attribute getter, once the path has been read from
+# that class by the checked walk below: its nested classes are fixed, so the getter reads the same
+_GETTERS: Dict[Tuple[type, Tuple[PathElem, ...]], Callable[[Any], Any]] = {}
+
+
 def extract(msg: Any, path: Tuple[PathElem, ...], raw: bool = False) -> Any:
     """The value at `path` in `msg`; FieldError when the type has no such field.
 
     A path ending in a slice or `[*]` (an array term, §12) gives the tuple of its elements
     as they are (messages stay messages): the engine reads each element's field later.
     """
+    getter = _GETTERS.get((type(msg), path))
+    if getter is not None:
+        try:
+            value = getter(msg)
+        except AttributeError:
+            pass  # not shaped like the first message of its class: the checked walk says why
+        else:
+            return value if raw else convert(value, path)
+    value, final = _walk(msg, path)
+    if final:
+        return value
+    if type(msg) is not dict and all(type(e) is str for e in path):
+        _GETTERS[(type(msg), path)] = operator.attrgetter(".".join(path))  # type: ignore[arg-type]
+    return value if raw else convert(value, path)
+
+
+def _walk(msg: Any, path: Tuple[PathElem, ...]) -> Tuple[Any, bool]:
+    """extract's checked walk: (the raw value, whether it is final: an array term, a missing element)."""
     value = msg
     for i, elem in enumerate(path):
         if isinstance(elem, Slice):
             if not isinstance(value, (list, tuple, bytes, bytearray)):
                 raise FieldError(f"'{path_text(path[:i])}' is not an array")
             part = value[elem.start:elem.stop]
-            return bytes(part) if isinstance(part, (bytes, bytearray)) else tuple(part)
+            return (bytes(part) if isinstance(part, (bytes, bytearray)) else tuple(part)), True
         if isinstance(elem, int):
             if not isinstance(value, (list, tuple, bytes, bytearray)):
                 raise FieldError(f"'{path_text(path[:i])}' is not an array")
             if not -len(value) <= elem < len(value):
-                return UNKNOWN  # arrays vary in length: a missing element is missing data
+                return UNKNOWN, True  # arrays vary in length: a missing element is missing data
             value = value[elem]
             continue
         if isinstance(value, dict):
@@ -55,7 +79,7 @@ def extract(msg: Any, path: Tuple[PathElem, ...], raw: bool = False) -> Any:
             value = getattr(value, elem)
         except AttributeError:
             raise FieldError(f"no field '{path_text(path[:i + 1])}'") from None
-    return value if raw else convert(value, path)
+    return value, False
 
 
 def convert(value: Any, path: Tuple[PathElem, ...] = ()) -> Any:
