@@ -120,7 +120,6 @@ class _Duals:
         return diff
 
     def dual(self, e: ast.Expr) -> Dual:
-        store = self.store
         if not time_dependent(e):
             fn = self.value_of(e)
             return lambda: (fn(), 0.0)

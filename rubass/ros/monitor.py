@@ -51,31 +51,24 @@ from ..engine.loop import EngineLoop, Message, NodeSample
 from ..lang import SpecError, load_spec
 from ..lang.library import priority_conflicts
 from ..lang.model import CheckedSpec
-from . import status as status_mod
-from .actions.base import ActionSetupError, make_plugin
+from ..actions import status as status_mod
+from ..actions.base import ActionSetupError, make_plugin
 from .agentbook import AGENT_TOPIC, AgentBook
 from .agentbook import decode as decode_agent_report
-from .actions.runner import ActionRunner
-from .dispatch import Dispatcher
+from ..actions.runner import ActionRunner
+from ..actions.dispatch import Dispatcher
 from .master_watch import MasterWatch
 from .libtypes import after_check
 from .nodes import NodeSampler
 from .outputs import Outputs
-from .overload import OverloadGuard
+from ..actions.overload import OverloadGuard
 from .clockjump import ClockJump
-from .errorguard import ErrorGuard
-from .keeper import LatchKeeper
-from .latches import LatchFile, default_path
+from ..actions.errorguard import ErrorGuard
+from ..actions.keeper import LatchKeeper
+from ..actions.latches import LatchFile, default_path
 from .params import MonitorConfig, ParamError, read_config
+from .reloading import ConfigError, Reloading, StartupError
 from .topics import TopicWatcher, ros_now
-
-
-class StartupError(Exception):
-    """The spec, a library or an action cannot be used: the message says why, for the user."""
-
-
-class ConfigError(StartupError):
-    """The parameters do not fit the spec (~overload_actions): the monitor exits."""
 
 
 def _log(level: str, text: str) -> None:
@@ -86,7 +79,7 @@ def _ros_now() -> float:
     return ros_now()
 
 
-class Monitor:
+class Monitor(Reloading):
     def __init__(self, config: MonitorConfig) -> None:
         self.config = config
         self.reloads = 0
@@ -343,111 +336,6 @@ class Monitor:
                 rospy.logerr_throttle(1, f"rubass: engine step failed: {exc.__class__.__name__}: {exc}")
 
     # -- control -------------------------------------------------------------------------
-    def reload_coalesced(self, reason: str) -> None:
-        """Reload, unless another request is already waiting behind the running reload: that
-        one will read the newest files anyway, so a storm of SIGHUPs costs at most two reloads."""
-        with self._pending_lock:
-            if self._reload_waiting:
-                self.coalesced += 1
-                return
-            self._reload_waiting = True
-        with self._reload_lock:
-            with self._pending_lock:
-                self._reload_waiting = False
-            self.reload(reason)
-
-    def reload(self, reason: str) -> Tuple[bool, str]:
-        """Re-read spec and libraries; swap atomically, or keep the old rules on any error."""
-        with self._reload_lock:
-            t0 = time.monotonic()
-            try:
-                spec = self._load_stable()
-                self._check_overload_actions(spec)
-                self._check_priorities(spec)
-                self._check_library_types(spec)
-                t_check = time.monotonic()
-                if self.spec is not None and self.loop is None:
-                    raise StartupError(f"not enforcing yet: {self._why_not()}; reload once it enforces")
-                if self.spec is None:  # not enforcing yet: this spec is the first usable one
-                    self._enforce(spec, self._runners(spec, {}))
-                    self.reloads += 1
-                    self.last_reload_error = ""
-                    return True, f"enforcing {spec.path}: {len(spec.rules)} rules, {len(spec.behaviours)} behaviours"
-                if spec.behaviours == [] and self.spec.behaviours:
-                    raise StartupError(f"{spec.path}: the new spec has no behaviours; refusing to drop every "
-                                       f"safety behaviour of the running spec (was the file caught half-written? "
-                                       f"to run without rules, restart the monitor)")
-                gone = [n for n, r in self.runners.items()
-                        if n not in spec.actions and r.active and self.spec.actions[n].latch]
-                if gone:  # actions are carried by name: a latched one that is on cannot just vanish
-                    raise StartupError(f"{spec.path}: the new spec no longer declares {', '.join(gone)}, which is "
-                                       f"latched and active; call ~reset first (or keep the action's name)")
-                runners = self._runners(spec, self.runners)
-            except (SpecError, StartupError) as exc:
-                text = exc.render() if isinstance(exc, SpecError) else str(exc)
-                self.rejected += 1
-                self.last_reload_error = text.splitlines()[0] if text else "error"
-                if self.spec is None:
-                    self.load_error = text
-                rospy.logerr("rubass: reload (%s) rejected, the previous rules keep running:\n%s", reason, text)
-                return False, f"rejected: {text}"
-            new_engine = Engine(spec, _ros_now())
-            t_build = time.monotonic()
-            for name, runner in runners.items():
-                if self.runners.get(name) is not runner:
-                    runner.start_thread()
-            self.loop.call(lambda old: self._swap(old, new_engine, spec, runners))  # type: ignore[union-attr]
-            t_swap = time.monotonic()
-            self.watcher.sync(spec)
-            if spec.nodes != self.spec.nodes:
-                self.sampler.stop()
-                self.sampler = self._sampler(spec)
-            dropped = [r for n, r in self.runners.items() if runners.get(n) is not r]
-            self.spec, self.runners = spec, runners
-            for runner in dropped:
-                runner.stop()
-                runner.plugin.close()
-            self.reloads += 1
-            self.last_reload_error = ""
-            ms = (time.monotonic() - t0) * 1000.0
-            rospy.loginfo("rubass: reloaded %s (%s) in %.0f ms: %d rules, %d behaviours (check %.0f ms, build %.0f ms, "
-                          "swap %.1f ms)", spec.path, reason, ms, len(spec.rules), len(spec.behaviours),
-                          (t_check - t0) * 1000, (t_build - t_check) * 1000, (t_swap - t_build) * 1000)
-            return True, f"reloaded in {ms:.0f} ms: {len(spec.rules)} rules, {len(spec.behaviours)} behaviours"
-
-    def _load_stable(self) -> CheckedSpec:
-        """load_spec, again if a file changed while it was read or within the last 50 ms (an
-        editor or a script still writing it): a half-written file must not become the rules."""
-        paths = [self.config.spec] + list(self.config.actions)
-        for _ in range(5):
-            before = _stamps(paths)
-            spec = load_spec(self.config.spec, self.config.actions)
-            files = paths + [lib for lib in spec.libraries if lib not in paths]
-            if _stamps(paths) == before and time.time() - _newest(_stamps(files)) > 0.05:
-                return spec
-            time.sleep(0.1)
-        return load_spec(self.config.spec, self.config.actions)
-
-    def _swap(self, old: Engine, new: Engine, spec: CheckedSpec, runners: Dict[str, ActionRunner]) -> None:
-        """On the engine's thread: nothing is evaluated between the old rules and the new."""
-        now = _ros_now()
-        events = new.adopt(old, now)
-        old_keys = self.dispatcher.keys_of(old.spec)
-        for orphan in new.orphans:
-            b = orphan.checked
-            if b.latched:
-                self.dispatcher.orphans.append((b, old_keys[b.index]))
-            else:
-                self.dispatcher.release(b, old_keys[b.index], now)
-        for name, runner in runners.items():  # actions are carried across any reload by name
-            prev = self.dispatcher.runners.get(name)
-            if prev is not None and prev is not runner:
-                runner.adopt(prev)
-        self.dispatcher.runners = runners
-        self.loop.engine = new  # type: ignore[union-attr]
-        self._on_events(events, "reload")  # the latch state is written before a latched start is dispatched
-        self.keeper.save(new, self.dispatcher.orphans, self._fail_safes())
-
     def reset(self) -> Tuple[bool, str]:
         now = _ros_now()
         loop = self.loop
@@ -508,6 +396,7 @@ class Monitor:
         monitor["clock jumps back"] = loop.clock_jumps
         if loop.dropped_by_topic:
             monitor["dropped by topic"] = ", ".join(f"{t} {n}" for t, n in sorted(loop.dropped_by_topic.items()))
+        monitor["last start"] = getattr(self.dispatcher, "last_start", "none")  # with its witnesses
         monitor["data errors"] = "; ".join(data_errors) or "none"
         if self.error_guard.active:
             monitor["data error actions"] = "running " + ", ".join(self.error_guard.actions)
@@ -553,22 +442,6 @@ class Monitor:
         for runner in self.runners.values():
             runner.stop(timeout=1.0)
             runner.plugin.close()
-
-
-def _stamps(paths: List[str]) -> List[Tuple[int, int]]:
-    """(mtime in ns, size) of each file; (0, -1) for one that cannot be read."""
-    out = []
-    for p in paths:
-        try:
-            st = os.stat(p)
-            out.append((st.st_mtime_ns, st.st_size))
-        except OSError:
-            out.append((0, -1))
-    return out
-
-
-def _newest(stamps: List[Tuple[int, int]]) -> float:
-    return max((m for m, _ in stamps), default=0) / 1e9
 
 
 def main(argv: Optional[List[str]] = None) -> int:

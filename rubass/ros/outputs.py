@@ -9,7 +9,7 @@ import rospy
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
 from std_msgs.msg import Header, String
 
-from .status import Entry
+from ..actions.status import Entry
 
 
 class Outputs:

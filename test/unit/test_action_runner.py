@@ -3,8 +3,8 @@ import threading
 import time
 
 from rubass.lang.library import ActionDef
-from rubass.ros.actions.base import ActionPlugin, Context
-from rubass.ros.actions.runner import ActionRunner
+from rubass.actions.base import ActionPlugin, Context
+from rubass.actions.runner import ActionRunner
 
 
 class Fake(ActionPlugin):
@@ -104,7 +104,7 @@ def test_slow_plugin_never_blocks_submit_and_holds_coalesce():
 
 
 def test_queue_stays_bounded_when_a_stuck_plugin_meets_a_flapping_condition():
-    from rubass.ros.actions import runner as runner_mod
+    from rubass.actions import runner as runner_mod
 
     p = Fake(slow=5.0, per_behaviour=True)
     r, _ = runner(p)

@@ -120,7 +120,7 @@ def test_replay_json_and_report_show_witnesses():
 
 
 def test_monitor_events_and_diagnostics_carry_the_witness():
-    from rubass.ros.dispatch import Dispatcher
+    from rubass.actions.dispatch import Dispatcher
 
     records = []
     d = Dispatcher({}, records.append, lambda: 0.3)

@@ -115,7 +115,7 @@ def test_replay_skips_a_broken_report():
 
 def test_diagnostics_warn_while_an_agent_is_silent_and_say_why_the_rule_is_unknown():
     from rubass.lang import check_text
-    from rubass.ros import status
+    from rubass.actions import status
 
     spec = check_text("entity arm: hog { rules: busy: cpu(node hog) > 50 %; }\n")
     why = "agent /rubass_agent_b on host 10.200.1.2 is silent: its last report came 0.5 s ago"

@@ -8,7 +8,7 @@ import pytest
 from rubass.lang import SpecError, check_text
 from rubass.lang.library import ActionDef, parse_library
 from rubass.lang.source import Source
-from rubass.ros.actions.base import ActionSetupError, make_plugin
+from rubass.actions.base import ActionSetupError, make_plugin
 
 
 @pytest.mark.parametrize("plugin", ["subprocess:Popen", "os:system", "antigravity:x", "webbrowser:open",

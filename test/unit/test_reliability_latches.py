@@ -2,7 +2,7 @@
 import json
 import os
 
-from rubass.ros.latches import Latch, LatchFile, default_path, load
+from rubass.actions.latches import Latch, LatchFile, default_path, load
 
 DECLARED = {"stop": True, "brake": False, "warn": False}
 

@@ -5,8 +5,8 @@ import threading
 import time
 
 from rubass.lang.library import ActionDef
-from rubass.ros.actions.base import ActionPlugin, Context
-from rubass.ros.actions.runner import ActionRunner
+from rubass.actions.base import ActionPlugin, Context
+from rubass.actions.runner import ActionRunner
 
 
 class AlwaysFails(ActionPlugin):

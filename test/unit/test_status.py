@@ -1,6 +1,6 @@
 """The monitor's /diagnostics entries, built from plain data (no ROS)."""
 from rubass.lang import check_text
-from rubass.ros import status
+from rubass.actions import status
 
 SPEC = "entity base { rules: fast: topic /cmd_vel.linear.x > 1; }\n"
 

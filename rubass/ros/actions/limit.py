@@ -20,7 +20,7 @@ import rospy
 
 from ...actions.clamp import AXES, clamp_twist
 from .arbiter import take_seat
-from .base import ActionPlugin, Context
+from ...actions.base import ActionPlugin, Context
 from .publish import ros_class
 
 LOG_EVERY = 5.0

@@ -3,7 +3,7 @@ from __future__ import annotations
 
 import rospy
 
-from .base import ActionPlugin, Context, describe
+from ...actions.base import ActionPlugin, Context, describe
 
 
 class LogPlugin(ActionPlugin):

@@ -9,7 +9,7 @@ import roslib.message
 import rospy
 
 from .arbiter import take_seat
-from .base import ActionPlugin, ActionSetupError, Context
+from ...actions.base import ActionPlugin, ActionSetupError, Context
 
 
 def ros_class(lookup: Any, type_name: str, where: str, kind: str) -> Any:

@@ -7,7 +7,7 @@ from typing import Any, Optional
 
 import serial
 
-from .base import ActionPlugin, Context
+from ...actions.base import ActionPlugin, Context
 
 REOPEN_PERIOD = 0.5
 

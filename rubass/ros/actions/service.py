@@ -7,7 +7,7 @@ from typing import Any, List
 import roslib.message
 import rospy
 
-from .base import ActionPlugin, Context
+from ...actions.base import ActionPlugin, Context
 from .publish import build_message, ros_class
 
 

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 from typing import Any, Callable, Dict, Optional, Sequence
 
-from .actions.base import Context
+from .base import Context
 
 KEY = ("rubass-overload", 0)  # the runners' identity for this pseudo-behaviour
 Log = Callable[[str, str], None]

@@ -11,7 +11,7 @@ import sysconfig
 from dataclasses import dataclass, field
 from typing import Any, Dict, List, Optional, Tuple
 
-from ...lang.library import ActionDef
+from ..lang.library import ActionDef
 
 
 class ActionSetupError(Exception):
@@ -142,24 +142,23 @@ class CustomPlugin(ActionPlugin):
             self.impl.close()
 
 
+# The built-in plugins (LANGUAGE.md §8, §16): name -> 'module:Class', imported when first used,
+# so this pure room never imports ROS itself.
+BUILTIN = {
+    "publish": "rubass.ros.actions.publish:PublishPlugin",
+    "serial": "rubass.ros.actions.serial_port:SerialPlugin",
+    "service": "rubass.ros.actions.service:ServicePlugin",
+    "limit": "rubass.ros.actions.limit:LimitPlugin",
+    "log": "rubass.ros.actions.log:LogPlugin",
+}
+
+
 def make_plugin(action: ActionDef) -> ActionPlugin:
     """The plugin object for a library action (not yet set up)."""
     if action.is_custom:
         return CustomPlugin(action)
-    if action.plugin == "publish":
-        from .publish import PublishPlugin
-        return PublishPlugin(action)
-    if action.plugin == "serial":
-        from .serial_port import SerialPlugin
-        return SerialPlugin(action)
-    if action.plugin == "service":
-        from .service import ServicePlugin
-        return ServicePlugin(action)
-    if action.plugin == "limit":
-        from .limit import LimitPlugin
-        return LimitPlugin(action)
-    from .log import LogPlugin
-    return LogPlugin(action)
+    module, _, cls = BUILTIN[action.plugin].partition(":")
+    return getattr(importlib.import_module(module), cls)(action)  # type: ignore[no-any-return]
 
 
 def _is_standard_library(module_name: str) -> bool:

@@ -10,8 +10,8 @@ from typing import Any, Callable, Dict, List, Optional
 from ..engine import Engine, Event
 from ..engine.loop import Message, NodeSample
 from ..lang.model import CheckedBehaviour
-from .actions.base import Context
-from .actions.runner import ActionRunner
+from .base import Context
+from .runner import ActionRunner
 
 Report = Callable[[Dict[str, Any]], None]
 

@@ -9,7 +9,7 @@ from __future__ import annotations
 from typing import Any, Callable, Dict, List, Sequence
 
 from ..engine import Engine, Event
-from .actions.base import Context
+from .base import Context
 from .latches import Latch, LatchFile, holders, load
 
 Log = Callable[[str, str], None]

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 from typing import Any, Callable, Dict, List, Sequence
 
-from .actions.base import Context
+from .base import Context
 
 KEY = ("rubass-data-error", 0)  # the runners' identity for this pseudo-behaviour
 Log = Callable[[str, str], None]

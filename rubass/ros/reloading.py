@@ -1,0 +1,169 @@
+"""Live reload of the monitor (SIGHUP, ~reload): re-read the spec and its libraries, check
+them, and swap them in on the engine's thread, or keep the running rules on any error. Active
+actions and latches are carried across by name (docs/failure-modes.md)."""
+from __future__ import annotations
+
+import os
+import threading
+import time
+from typing import Any, Dict, List, Optional, Tuple
+
+import rospy
+
+from ..actions.runner import ActionRunner
+from ..engine import Engine
+from ..lang import SpecError, load_spec
+from ..lang.errors import RubassError
+from ..lang.model import CheckedSpec
+from .topics import ros_now
+
+
+class StartupError(RubassError):
+    """The spec, a library or an action cannot be used: the message says why, for the user."""
+
+
+class ConfigError(StartupError):
+    """The parameters do not fit the spec (~overload_actions): the monitor exits."""
+
+
+class Reloading:
+    """The reload half of the Monitor (mixed into it): reads `config`, `spec`, `runners`, `loop`,
+    `dispatcher`, `keeper`, `watcher`, `sampler` and the checks the Monitor defines."""
+
+    config: Any
+    spec: Optional[CheckedSpec]
+    runners: Dict[str, ActionRunner]
+    loop: Any
+    dispatcher: Any
+    keeper: Any
+    watcher: Any
+    sampler: Any
+    reloads: int
+    rejected: int
+    coalesced: int
+    last_reload_error: str
+    load_error: str
+    _pending_lock: threading.Lock
+    _reload_lock: threading.RLock
+    _reload_waiting: bool
+
+    def reload_coalesced(self, reason: str) -> None:
+        """Reload, unless another request is already waiting behind the running reload: that
+        one will read the newest files anyway, so a storm of SIGHUPs costs at most two reloads."""
+        with self._pending_lock:
+            if self._reload_waiting:
+                self.coalesced += 1
+                return
+            self._reload_waiting = True
+        with self._reload_lock:
+            with self._pending_lock:
+                self._reload_waiting = False
+            self.reload(reason)
+
+    def reload(self, reason: str) -> Tuple[bool, str]:
+        """Re-read spec and libraries; swap atomically, or keep the old rules on any error."""
+        with self._reload_lock:
+            t0 = time.monotonic()
+            try:
+                spec = self._load_stable()
+                self._check_overload_actions(spec)
+                self._check_priorities(spec)
+                self._check_library_types(spec)
+                t_check = time.monotonic()
+                if self.spec is not None and self.loop is None:
+                    raise StartupError(f"not enforcing yet: {self._why_not()}; reload once it enforces")
+                if self.spec is None:  # not enforcing yet: this spec is the first usable one
+                    self._enforce(spec, self._runners(spec, {}))
+                    self.reloads += 1
+                    self.last_reload_error = ""
+                    return True, f"enforcing {spec.path}: {len(spec.rules)} rules, {len(spec.behaviours)} behaviours"
+                if spec.behaviours == [] and self.spec.behaviours:
+                    raise StartupError(f"{spec.path}: the new spec has no behaviours; refusing to drop every "
+                                       f"safety behaviour of the running spec (was the file caught half-written? "
+                                       f"to run without rules, restart the monitor)")
+                gone = [n for n, r in self.runners.items()
+                        if n not in spec.actions and r.active and self.spec.actions[n].latch]
+                if gone:  # actions are carried by name: a latched one that is on cannot just vanish
+                    raise StartupError(f"{spec.path}: the new spec no longer declares {', '.join(gone)}, which is "
+                                       f"latched and active; call ~reset first (or keep the action's name)")
+                runners = self._runners(spec, self.runners)
+            except (SpecError, StartupError) as exc:
+                text = exc.render() if isinstance(exc, SpecError) else str(exc)
+                self.rejected += 1
+                self.last_reload_error = text.splitlines()[0] if text else "error"
+                if self.spec is None:
+                    self.load_error = text
+                rospy.logerr("rubass: reload (%s) rejected, the previous rules keep running:\n%s", reason, text)
+                return False, f"rejected: {text}"
+            new_engine = Engine(spec, ros_now())
+            t_build = time.monotonic()
+            for name, runner in runners.items():
+                if self.runners.get(name) is not runner:
+                    runner.start_thread()
+            self.loop.call(lambda old: self._swap(old, new_engine, spec, runners))  # type: ignore[union-attr]
+            t_swap = time.monotonic()
+            self.watcher.sync(spec)
+            if spec.nodes != self.spec.nodes:
+                self.sampler.stop()
+                self.sampler = self._sampler(spec)
+            dropped = [r for n, r in self.runners.items() if runners.get(n) is not r]
+            self.spec, self.runners = spec, runners
+            for runner in dropped:
+                runner.stop()
+                runner.plugin.close()
+            self.reloads += 1
+            self.last_reload_error = ""
+            ms = (time.monotonic() - t0) * 1000.0
+            rospy.loginfo("rubass: reloaded %s (%s) in %.0f ms: %d rules, %d behaviours (check %.0f ms, build %.0f ms, "
+                          "swap %.1f ms)", spec.path, reason, ms, len(spec.rules), len(spec.behaviours),
+                          (t_check - t0) * 1000, (t_build - t_check) * 1000, (t_swap - t_build) * 1000)
+            return True, f"reloaded in {ms:.0f} ms: {len(spec.rules)} rules, {len(spec.behaviours)} behaviours"
+
+    def _load_stable(self) -> CheckedSpec:
+        """load_spec, again if a file changed while it was read or within the last 50 ms (an
+        editor or a script still writing it): a half-written file must not become the rules."""
+        paths = [self.config.spec] + list(self.config.actions)
+        for _ in range(5):
+            before = _stamps(paths)
+            spec = load_spec(self.config.spec, self.config.actions)
+            files = paths + [lib for lib in spec.libraries if lib not in paths]
+            if _stamps(paths) == before and time.time() - _newest(_stamps(files)) > 0.05:
+                return spec
+            time.sleep(0.1)
+        return load_spec(self.config.spec, self.config.actions)
+
+    def _swap(self, old: Engine, new: Engine, spec: CheckedSpec, runners: Dict[str, ActionRunner]) -> None:
+        """On the engine's thread: nothing is evaluated between the old rules and the new."""
+        now = ros_now()
+        events = new.adopt(old, now)
+        old_keys = self.dispatcher.keys_of(old.spec)
+        for orphan in new.orphans:
+            b = orphan.checked
+            if b.latched:
+                self.dispatcher.orphans.append((b, old_keys[b.index]))
+            else:
+                self.dispatcher.release(b, old_keys[b.index], now)
+        for name, runner in runners.items():  # actions are carried across any reload by name
+            prev = self.dispatcher.runners.get(name)
+            if prev is not None and prev is not runner:
+                runner.adopt(prev)
+        self.dispatcher.runners = runners
+        self.loop.engine = new  # type: ignore[union-attr]
+        self._on_events(events, "reload")  # the latch state is written before a latched start is dispatched
+        self.keeper.save(new, self.dispatcher.orphans, self._fail_safes())
+
+
+def _stamps(paths: List[str]) -> List[Tuple[int, int]]:
+    """(mtime in ns, size) of each file; (0, -1) for one that cannot be read."""
+    out = []
+    for p in paths:
+        try:
+            st = os.stat(p)
+            out.append((st.st_mtime_ns, st.st_size))
+        except OSError:
+            out.append((0, -1))
+    return out
+
+
+def _newest(stamps: List[Tuple[int, int]]) -> float:
+    return max((m for m, _ in stamps), default=0) / 1e9
