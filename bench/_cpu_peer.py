@@ -3,10 +3,11 @@
 
 bare PROFILE            a bare rospy subscriber: one rospy.AnyMsg subscriber per topic of the
                         profile, counting; prints {"received": N} when stopped (SIGTERM/SIGINT)
-pub PROFILE SCALE SECONDS WAIT
-                        publish the profile's topics at SCALE x their rates, once WAIT subscribers
-                        are connected to every topic; prints "start" when it begins, then
-                        {"published": N, "seconds": S} when done
+pub PROFILE SCALE SECONDS WAIT [PART PARTS]
+                        publish the profile's topics (those numbered PART modulo PARTS) at SCALE x
+                        their rates, once WAIT subscribers are connected to every topic: prints
+                        "ready", starts at a line "go" on stdin, and prints {"published": N,
+                        "seconds": S} when done
 """
 import json
 import math
@@ -115,9 +116,9 @@ def bare(name):
         s.unregister()
 
 
-def pub(name, scale, seconds, wait):
-    rospy.init_node("bench_cpu_pub", anonymous=True)
-    topics = profile(name)
+def pub(name, scale, seconds, wait, part=0, parts=1):
+    rospy.init_node("bench_cpu_pub" if part == 0 else f"bench_cpu_pub_{part}")
+    topics = [t for i, t in enumerate(profile(name)) if i % parts == part]
     pubs = [(rospy.Publisher(t, _type_of(kind), queue_size=100, tcp_nodelay=True), kind, hz * scale)
             for t, kind, hz in topics]
     samples = {kind: [messages(kind, k) for k in range(4)] for _, kind, _ in topics}
@@ -125,12 +126,13 @@ def pub(name, scale, seconds, wait):
     while any(p.get_num_connections() < wait for p, _, _ in pubs) and time.monotonic() < end:
         time.sleep(0.05)
     time.sleep(1.0)  # every connection of every subscriber up
+    print("ready", flush=True)
+    sys.stdin.readline()  # "go": every publisher starts at once
     # one schedule of (due, publisher): each topic at its own rate, phases spread
     t0 = time.monotonic() + 0.05
     heap = [(t0 + i / (len(pubs) * hz), i) for i, (_, _, hz) in enumerate(pubs)]
     import heapq
     heapq.heapify(heap)
-    print("start", flush=True)
     n = 0
     stamp = rospy.Time.now
     stop = t0 + seconds
@@ -158,4 +160,4 @@ if __name__ == "__main__":
     if role == "bare":
         bare(sys.argv[2])
     else:
-        pub(sys.argv[2], float(sys.argv[3]), float(sys.argv[4]), int(sys.argv[5]))
+        pub(sys.argv[2], float(sys.argv[3]), float(sys.argv[4]), int(sys.argv[5]), *map(int, sys.argv[6:8]))

@@ -12,6 +12,7 @@ publishing window is divided by the messages published in it. Cases:
 (c) a rate ramp of (a) and (b): every rate x1, x2, x4, ... until both lose messages (or the
     publisher cannot go faster); the highest rate each keeps without losing any.
 Targets: ratio <= 1.5 in (a) and (b); in (c) the monitor keeps up to >= 80 % of the bare rate.
+(c) publishes from up to 5 processes, all of them on the same machine as the subscribers.
 Prints one JSON object per case. Usage: bench/cpu.py [--seconds S] [--cases abc] [--smoke]
 """
 import argparse
@@ -114,34 +115,38 @@ def _detail(pid):
     return t.user, t.system, switches
 
 
-def run_case(master, tmp, profile, spec, scale, seconds):
-    """One run: monitor and bare subscriber together, publishing at `scale` x the profile's rates."""
-    bare = pub = mon = None
+def run_case(master, tmp, profile, spec, scale, seconds, parts=1):
+    """One run: monitor and bare subscriber together, publishing at `scale` x the profile's rates
+    from `parts` publisher processes (one Python publisher tops out at about 6,000 messages/s)."""
+    bare = mon = None
+    pubs = []
     try:
         bare = subprocess.Popen([PY, PEER, "bare", profile], env=master.env, stdout=subprocess.PIPE,
                                 stderr=subprocess.DEVNULL, text=True, start_new_session=True)
         mon, _ = start_monitor(master, tmp, spec)
-        pub = subprocess.Popen([PY, PEER, "pub", profile, str(scale), str(seconds), "2"], env=master.env,
-                               stdout=subprocess.PIPE, stderr=open(os.path.join(tmp, "pub.log"), "w"), text=True, start_new_session=True)
-        c0 = t0 = None
-        done = None
-        for line in pub.stdout:
-            if line.startswith("start"):
-                t0, c0 = time.monotonic(), (_cpu(mon.pid), _cpu(bare.pid))
-                d0 = (_detail(mon.pid), _detail(bare.pid))
-            elif line.startswith("{"):
-                done = json.loads(line)
-                break
-        if done is None or c0 is None:
-            raise SystemExit("the publisher did not run: " + open(os.path.join(tmp, "pub.log")).read()[-2000:])
+        for part in range(parts):
+            pubs.append(subprocess.Popen([PY, PEER, "pub", profile, str(scale), str(seconds), "2", str(part), str(parts)],
+                                         env=master.env, stdin=subprocess.PIPE, stdout=subprocess.PIPE,
+                                         stderr=open(os.path.join(tmp, f"pub{part}.log"), "w"), text=True,
+                                         start_new_session=True))
+        if not all(p.stdout.readline().startswith("ready") for p in pubs):
+            raise SystemExit("a publisher did not start: " + open(os.path.join(tmp, "pub0.log")).read()[-2000:])
+        t0, c0 = time.monotonic(), (_cpu(mon.pid), _cpu(bare.pid))
+        d0 = (_detail(mon.pid), _detail(bare.pid))
+        for p in pubs:
+            p.stdin.write("go\n")
+            p.stdin.flush()
+        outs = [json.loads(p.stdout.readline()) for p in pubs]
         time.sleep(0.3)  # what is still queued is handled (its CPU belongs to the window)
         t1, c1 = time.monotonic(), (_cpu(mon.pid), _cpu(bare.pid))
         d1 = (_detail(mon.pid), _detail(bare.pid))
-        pub.wait(10)
+        for p in pubs:
+            p.wait(10)
     finally:
-        stop_processes([p for p in (pub, mon) if p is not None])
+        stop_processes([p for p in pubs + [mon] if p is not None])
         if bare is not None:
             stop_processes([bare])
+    done = {"published": sum(o["published"] for o in outs), "seconds": max(o["seconds"] for o in outs)}
     bare_out = [json.loads(x) for x in bare.stdout.read().splitlines() if x.startswith("{")]
     log = open(os.path.join(tmp, "monitor.log")).read()
     m = re.search(r"stopped after (\d+) messages \((\d+) dropped", log)
@@ -163,26 +168,31 @@ def run_case(master, tmp, profile, spec, scale, seconds):
     }
 
 
-def ramp(master, tmp, profile, spec, seconds, scales):
+def ramp(master, tmp, profile, spec, seconds, scales, parts):
     """Each scale in turn until both lose messages or the publisher falls behind its schedule."""
     steps, kept = [], {"monitor": 0.0, "bare": 0.0}
     for scale in scales:
-        r = run_case(master, tmp, profile, spec, scale, seconds)
+        r = run_case(master, tmp, profile, spec, scale, seconds, parts)
         r["scale"] = scale
         steps.append(r)
         for who in kept:
             if r[f"{who}_lost"] == 0:
                 kept[who] = max(kept[who], r["rate_msgs_per_s"])
         behind = r["rate_msgs_per_s"] < 0.8 * base_rate(profile) * scale  # the publisher is the limit
+        r["publishers_behind"] = behind
         if (r["monitor_lost"] and r["bare_lost"]) or behind:
             break
     return steps, kept
 
 
-def base_rate(profile):
+def _topics(profile):
     sys.path.insert(0, os.path.dirname(PEER))
     from _cpu_peer import profile as topics_of
-    return sum(hz for _, _, hz in topics_of(profile))
+    return topics_of(profile)
+
+
+def base_rate(profile):
+    return sum(hz for _, _, hz in _topics(profile))
 
 
 def main():
@@ -206,7 +216,8 @@ def main():
             if "c" in args.cases:
                 for name, profile, spec in cases:
                     scales = [1.0] if args.smoke else [1, 2, 4, 8, 16, 32]
-                    steps, kept = ramp(master, tmp, profile, spec, min(seconds, 5.0), scales)
+                    parts = 1 if args.smoke else len(_topics(profile))
+                    steps, kept = ramp(master, tmp, profile, spec, min(seconds, 5.0), scales, min(parts, 5))
                     ok = kept["bare"] > 0 and kept["monitor"] >= 0.8 * kept["bare"]
                     print(json.dumps({"benchmark": "cpu", "case": "c", "profile": name,
                                       "monitor_kept_msgs_per_s": kept["monitor"], "bare_kept_msgs_per_s": kept["bare"],

@@ -436,9 +436,15 @@ class Engine:
                     and changed.isdisjoint(node.slots) and moved.isdisjoint(node.inputs):
                 continue
             node.fresh = False
-            value = node.compiled.fn()
-            if node.compiled.ops:
-                self._schedule(i, node)
+            compiled = node.compiled
+            value = compiled.fn()
+            if compiled.ops:  # _schedule, inline: the deadlines its operators announce now
+                pushed = node.pushed
+                for op in compiled.ops:
+                    due = op.deadline()
+                    if due is not None and pushed.get(id(op)) != due:
+                        pushed[id(op)] = due
+                        heapq.heappush(self._heap, (due, next(self._seq), i, op))
             b = node.behaviour
             if b is None:
                 key = node.key
