@@ -300,6 +300,8 @@ class Engine:
         for i, node in enumerate(self._nodes):
             if node.active and node.value is not True:
                 node.active = False
+                for a in node.actions:  # active() of its actions ends with it
+                    self._holders.get(a, set()).discard(node.key)
                 released.append(i)
                 events.append(self._event(node, "release"))
         for action in list(self._holders):
