@@ -141,8 +141,8 @@ class Engine:
                     readers.setdefault(e.action, []).append(i)
                 elif isinstance(e, ast.RuleRef):
                     self._nodes[self._at[e.key]].users.add(i)
-            if any(type(op).__name__ == "Crossings" for op in node.compiled.ops):
-                timed.append(i)
+            if any(isinstance(e, (ast.Age, ast.StampAge, ast.Frequency)) for e in ast.walk(expr)):
+                timed.append(i)  # ticks re-evaluate whatever time changes, where no crossing is announced too
             topics_of.append(topics)
             nodes_of.append(nodes)
             node.volatile, node.slots, node.inputs = volatile, frozenset(slots), frozenset(inputs[i])

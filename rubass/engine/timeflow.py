@@ -6,7 +6,8 @@ with its slope: each such expression gets a second closure returning (value, d v
 A comparison whose sides depend on time, and each min/max/abs/sqrt kink inside them, announce
 the instant their difference reaches zero. For sums, differences, scalar multiples, min, max and
 abs of ages this instant is exact; for products or quotients of two times, sqrt and hypot it is a
-Newton step from the side that is not yet crossed, taken again at each evaluation.
+Newton step from the side that is not yet crossed, taken again at each evaluation. Time inside a
+quantifier's body or a zone's point is not followed here: the engine's ticks evaluate it.
 """
 from __future__ import annotations
 
@@ -95,8 +96,6 @@ def crossings(expr: ast.Expr, value_of: Callable[[ast.Expr], Callable[[], Any]],
                           if time_dependent(a) or time_dependent(b)]
             elif e.func in ("abs", "sqrt"):
                 diffs.append(duals.dual(args[0]))
-        elif isinstance(e, ast.Zone) and (time_dependent(e.x) or time_dependent(e.y)):
-            pass  # a point that moves with time alone: followed at each tick
         stack.extend(ast.children(e))
     if not diffs and not windows:
         return None
