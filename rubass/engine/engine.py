@@ -325,6 +325,27 @@ class Engine:
             self._run(self._plan(seeds), events)
         return events
 
+    def release_holder(self, holder: str, now: float) -> List[Event]:
+        """End an outside holder's hold on every action (before ~reset); readers of active() run."""
+        events = self.advance(now)
+        touched = [a for a, hs in self._holders.items() if holder in hs]
+        for a in touched:
+            self._holders[a].discard(holder)
+        self._sync_actions()
+        seeds = [r for a in touched for r in self._readers.get(a, ())]
+        if seeds:
+            self._run(self._plan(seeds), events)
+        return events
+
+    def outside_holders(self) -> Dict[str, Tuple[str, ...]]:
+        """Holders other than this spec's behaviours (restored latches, …) and the actions they hold."""
+        out: Dict[str, List[str]] = {}
+        for action, holders in self._holders.items():
+            for h in holders:
+                if not h.startswith("b:"):
+                    out.setdefault(h, []).append(action)
+        return {h: tuple(sorted(a)) for h, a in out.items()}
+
     def active_actions(self) -> Dict[str, Tuple[str, ...]]:
         """Each active action and who holds it: behaviour names ('behaviour N' when unnamed) or outside holders."""
         out: Dict[str, Tuple[str, ...]] = {}

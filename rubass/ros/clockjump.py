@@ -22,19 +22,20 @@ MARGIN = 0.5  # seconds beyond the longest time a condition needs to become true
 
 
 def horizon(spec: Any) -> float:
-    """How long after a restart a persisting violation may take to be seen again."""
+    """How long after a restart a persisting violation may take to be seen again: the longest
+    `for`, `within` or `frequency` window, or limit an `age`/`stamp_age` is compared with."""
     longest = 0.0
     exprs = [r.expr for r in spec.rules] + [b.cond for b in spec.behaviours]
     for expr in exprs:
         for e in ast.walk(expr):
             times: List[Any] = []
-            if isinstance(e, ast.For):
+            if isinstance(e, (ast.For, ast.Within)):
                 times.append(getattr(e.duration, "value", None))
-            elif isinstance(e, ast.Call) and e.func == "frequency" and len(e.args) > 1:
-                times.append(getattr(e.args[1], "value", None))
+            elif isinstance(e, ast.Frequency):
+                times.append(e.window)
             elif isinstance(e, ast.Binary) and e.op in ("<", "<=", ">", ">="):
                 for side, other in ((e.left, e.right), (e.right, e.left)):
-                    if isinstance(side, ast.Call) and side.func in ("age", "stamp_age"):
+                    if any(isinstance(x, (ast.Age, ast.StampAge)) for x in ast.walk(side)):
                         times.append(getattr(other, "value", None))
             longest = max([longest] + [t for t in times if isinstance(t, float) and 0.0 < t < 3600.0])
     return longest + MARGIN
@@ -55,18 +56,24 @@ class ClockJump:
         keys = self.dispatcher.keys_of(old.spec)
         until = now + horizon(old.spec)
         held = []
+        events: List[Event] = []
+        for holder, actions in old.outside_holders().items():  # restored latches and earlier carries
+            events += new.hold_actions(actions, holder, now)
         for index in old.active_behaviours():
             b = old.spec.behaviours[index - 1]
             held.append(str(index))
+            actions = [a.name for a in b.actions]
             if b.latched:
                 self.dispatcher.orphans.append((b, keys[index]))
+                events += new.hold_actions(actions, f"{b.label} (latched before a clock jump)", now)
             else:
                 self.carried.append((b, keys[index], until))
+                events += new.hold_actions(actions, _carried(b), now)  # active() stays true meanwhile
         self.log("warn", f"ROS time jumped back from {old.store.now:.3f} s to {now:.3f} s (a simulator reset?): "
                          f"every `for`, `age` and `frequency` window starts again from now"
                          + (f"; active behaviours {', '.join(held)} stay active (latched ones until ~reset)"
                             if held else ""))
-        events = new.evaluate_all(now)
+        events += new.evaluate_all(now)
         self.after(new)
         return new, events
 
@@ -78,9 +85,15 @@ class ClockJump:
         keep = []
         for b, key, until in self.carried:
             if b.index in active and engine.spec.behaviours[b.index - 1] is b:
+                self.dispatcher.handle(engine, engine.release_holder(_carried(b), now), "clock jump")
                 continue  # the engine holds it again, under the same identity
             if now >= until or now < until - 3600.0:
                 self.dispatcher.release(b, key, now)
+                self.dispatcher.handle(engine, engine.release_holder(_carried(b), now), "clock jump")
             else:
                 keep.append((b, key, until))
         self.carried = keep
+
+
+def _carried(b: Any) -> str:
+    return f"{b.label} (carried across a clock jump)"

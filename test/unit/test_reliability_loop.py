@@ -100,6 +100,9 @@ def test_clock_jump_hook_holds_what_was_active_until_the_rebuilt_engine_takes_it
         def release(self, b, key, now):
             released.append((b.index, now))
 
+        def handle(self, engine, events, cause):
+            pass
+
     assert horizon(loop.engine.spec) == 1.5
     hook = ClockJump(Dispatcher(), lambda level, text: None, lambda engine: None)
     loop.on_clock_jump = hook
@@ -132,6 +135,9 @@ def test_after_a_clock_jump_a_latched_behaviour_is_held_until_reset_like_after_a
         def keys_of(self, spec):
             return {b.index: ("k", b.index) for b in spec.behaviours}
 
+        def handle(self, engine, events, cause):
+            pass
+
     d = Dispatcher()
     loop.on_clock_jump = ClockJump(d, lambda level, text: None, lambda engine: None)
     clock.t += 0.1
@@ -140,3 +146,43 @@ def test_after_a_clock_jump_a_latched_behaviour_is_held_until_reset_like_after_a
     clock.t = 10.0
     loop.step(max_wait=0)
     assert [(b.index, key) for b, key in d.orphans] == [(1, ("k", 1))]
+
+
+def test_the_clock_jump_horizon_covers_every_window_of_time_in_v2():
+    from rubass.ros.clockjump import horizon
+
+    loop, _, _ = make("entity a { rules:\n"
+                      "  s: age(topic /scan) > 2 s;\n"
+                      "  f: frequency(topic /scan, 3 s) < 5 Hz;\n"
+                      "  w: topic /b.p within 4 s;\n"
+                      "  t: stamp_age(topic /imu) + 0.1 s > 2.5 s;\n"
+                      "}\nif (a.s or a.f or a.w or a.t) then { warn; }\n")
+    assert horizon(loop.engine.spec) == 4.5  # the within window, + 0.5 s
+
+
+def test_after_a_clock_jump_active_of_a_held_action_stays_true_until_reset():
+    from rubass.ros.clockjump import ClockJump
+
+    loop, clock, got = make("entity a { rules: r: topic /x.data > 1; m: topic /y.data > 0; }\n"
+                            "if (a.r) then { stop; }\nif (active(stop) and a.m) then { warn; }\n")
+
+    class Dispatcher:
+        orphans = []
+
+        def keys_of(self, spec):
+            return {b.index: ("k", b.index) for b in spec.behaviours}
+
+    loop.on_clock_jump = ClockJump(Dispatcher(), lambda level, text: None, lambda engine: None)
+    clock.t += 0.1
+    loop.submit(Message("/x", clock.t, {"data": 5.0}))
+    loop.step(max_wait=0)
+    clock.t = 10.0  # back in time: the engine is rebuilt
+    loop.submit(Message("/x", clock.t, {"data": 0.0}))
+    loop.step(max_wait=0)
+    assert loop.engine.active_actions() == {"stop": ("behaviour 1 (latched before a clock jump)",)}
+    clock.t = 10.5
+    loop.submit(Message("/y", clock.t, {"data": 1.0}))  # the ladder still sees the stop
+    loop.step(max_wait=0)
+    assert 2 in loop.engine.active_behaviours()
+    loop.engine.reset(clock.t)
+    assert loop.engine.active_actions().get("stop") is None
