@@ -4,6 +4,7 @@ actions and latches are carried across by name (docs/failure-modes.md)."""
 from __future__ import annotations
 
 import os
+import queue
 import threading
 import time
 from typing import Any, Dict, List, Optional, Tuple
@@ -95,12 +96,25 @@ class Reloading:
                     self.load_error = text
                 rospy.logerr("rubass: reload (%s) rejected, the previous rules keep running:\n%s", reason, text)
                 return False, f"rejected: {text}"
-            new_engine = Engine(spec, ros_now())
-            t_build = time.monotonic()
-            for name, runner in runners.items():
-                if self.runners.get(name) is not runner:
+            built = [r for n, r in runners.items() if self.runners.get(n) is not r]
+            try:
+                new_engine = Engine(spec, ros_now())
+                t_build = time.monotonic()
+                for runner in built:
                     runner.start_thread()
-            self.loop.call(lambda old: self._swap(old, new_engine, spec, runners))  # type: ignore[union-attr]
+                self.loop.call(lambda old: self._swap(old, new_engine, spec, runners))  # type: ignore[union-attr]
+            except queue.Empty:
+                raise  # the swap may still happen on the engine's thread: keep what it will use
+            except Exception as exc:  # a bug must not leave half a reload: the running rules stay whole
+                for runner in built:
+                    runner.stop(timeout=1.0)
+                    runner.plugin.close()
+                text = f"{exc.__class__.__name__}: {exc}"
+                self.rejected += 1
+                self.last_reload_error = text
+                rospy.logerr("rubass: reload (%s) failed while swapping in the new rules, the previous rules keep "
+                             "running: %s", reason, text)
+                return False, f"rejected: {text}"
             t_swap = time.monotonic()
             self.watcher.sync(spec)
             if spec.nodes != self.spec.nodes:
@@ -135,6 +149,7 @@ class Reloading:
     def _swap(self, old: Engine, new: Engine, spec: CheckedSpec, runners: Dict[str, ActionRunner]) -> None:
         """On the engine's thread: nothing is evaluated between the old rules and the new."""
         now = ros_now()
+        self._on_events(old.advance(now), "deadline")  # what fell due up to the swap, under the old rules
         events = new.adopt(old, now)
         old_keys = self.dispatcher.keys_of(old.spec)
         for orphan in new.orphans:

@@ -1,0 +1,44 @@
+"""The monitor's swap of a reloaded spec (rubass/ros/reloading.py) with the engine's real objects
+and fakes for ROS: nothing that fell due before the swap is lost."""
+import os
+
+import pytest
+
+pytest.importorskip("rospy")
+
+from rubass.engine import Engine  # noqa: E402
+from rubass.lang import check_text  # noqa: E402
+from rubass.ros import reloading  # noqa: E402
+
+from conftest import ROOT  # noqa: E402
+
+LIB = os.path.join(ROOT, "docs", "examples", "actions.yaml")
+SPEC = "action primitive warn;\nentity a { rules: r: (topic /x.data > 1) for 1 s; }\nif (a.r) then { warn; }\n"
+
+
+class FakeMonitor(reloading.Reloading):
+    def __init__(self, engine):
+        self.dispatched = []
+        self.loop = type("Loop", (), {"engine": engine})()
+        self.dispatcher = type("D", (), {"orphans": [], "runners": {}, "keys_of": lambda s, spec: {},
+                                         "release": lambda *a: None})()
+        self.keeper = type("K", (), {"save": lambda *a: None})()
+
+    def _on_events(self, events, cause):
+        self.dispatched += [(e.kind, e.time, cause) for e in events if e.kind != "rule"]
+
+    def _fail_safes(self):
+        return []
+
+
+def test_a_deadline_due_at_the_reload_is_dispatched_under_the_old_rules(monkeypatch):
+    spec = check_text(SPEC, os.path.join(ROOT, "s.rbs"), [LIB])
+    old = Engine(spec, 0.0)
+    old.evaluate_all(0.0)
+    old.on_message("/x", 0.5, {"data": 5.0})  # the `for` falls due at 1.5, before the swap at 2.0
+    monitor = FakeMonitor(old)
+    monkeypatch.setattr(reloading, "ros_now", lambda: 2.0)
+    new = Engine(check_text(SPEC, os.path.join(ROOT, "s.rbs"), [LIB]), 2.0)
+    monitor._swap(old, new, new.spec, {})
+    assert ("start", 1.5, "deadline") in monitor.dispatched  # the stop started: it was not swallowed
+    assert new.active_behaviours() == [1] and monitor.loop.engine is new
