@@ -29,12 +29,13 @@ class Dispatcher:
 
     @staticmethod
     def keys(behaviours: List[CheckedBehaviour]) -> Dict[int, Any]:
-        """Each behaviour's identity across reloads: its signature, numbered among identical twins."""
+        """Each behaviour's identity across reloads (as the engine carries it: by name and actions,
+        unnamed by condition and actions), numbered among identical twins."""
         seen: Dict[str, int] = {}
         out: Dict[int, Any] = {}
         for b in behaviours:
-            seen[b.signature] = seen.get(b.signature, 0) + 1
-            out[b.index] = (b.signature, seen[b.signature])
+            seen[b.identity] = seen.get(b.identity, 0) + 1
+            out[b.index] = (b.identity, seen[b.identity])
         return out
 
     def handle(self, engine: Engine, events: List[Event], cause: Any) -> None:

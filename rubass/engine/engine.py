@@ -395,11 +395,11 @@ class Engine:
                 self._take_ops(prev, node)
                 if node.key in src.rules:
                     dst.rules[node.key] = src.rules[node.key]
-        old_behaviours = {_identity(n.behaviour): n for n in old._nodes if n.behaviour}
+        old_behaviours = {n.behaviour.identity: n for n in old._nodes if n.behaviour}
         for node in self._nodes:
             if not node.behaviour:
                 continue
-            prev = old_behaviours.pop(_identity(node.behaviour), None)
+            prev = old_behaviours.pop(node.behaviour.identity, None)
             if prev is not None:
                 if prev.behaviour.signature == node.behaviour.signature:  # type: ignore[union-attr]
                     self._take_ops(prev, node)
@@ -498,11 +498,6 @@ class Engine:
             if node.pushed.get(id(op)) != due:
                 node.pushed[id(op)] = due
                 heapq.heappush(self._heap, (due, next(self._seq), idx, op))
-
-
-def _identity(b: Any) -> str:
-    """A behaviour's identity across reloads: its name, else its condition and actions."""
-    return f"name:{b.name}" if b.name else f"sig:{b.signature}"
 
 
 STAMP: Tuple[ast.PathElem, ...] = ("header", "stamp")

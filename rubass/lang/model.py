@@ -52,6 +52,14 @@ class CheckedBehaviour:
     attrs: Attrs = field(default_factory=dict)
 
     @property
+    def identity(self) -> str:
+        """Who it is across a live reload, for the engine and the dispatcher alike: its name and its
+        actions, or (unnamed) its condition and actions."""
+        if not self.name:
+            return f"sig:{self.signature}"
+        return f"name:{self.name} {{{' '.join(a.name + repr(a.args) for a in self.actions)}}}"
+
+    @property
     def label(self) -> str:
         """How events, tests and reports name it: its name, else 'behaviour N'."""
         return self.name or f"behaviour {self.index}"

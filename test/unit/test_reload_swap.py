@@ -42,3 +42,21 @@ def test_a_deadline_due_at_the_reload_is_dispatched_under_the_old_rules(monkeypa
     monitor._swap(old, new, new.spec, {})
     assert ("start", 1.5, "deadline") in monitor.dispatched  # the stop started: it was not swallowed
     assert new.active_behaviours() == [1] and monitor.loop.engine is new
+
+
+def test_a_named_active_behaviour_whose_rule_changed_is_released_by_its_runner_after_a_reload():
+    from rubass.actions.dispatch import Dispatcher
+
+    text = "action primitive warn;\nentity a {{ rules: r: topic /x.data > {}; }}\noverspeed: if (a.r) then {{ warn; }}\n"
+    old_spec = check_text(text.format(1), os.path.join(ROOT, "s.rbs"), [LIB])
+    new_spec = check_text(text.format(2), os.path.join(ROOT, "s.rbs"), [LIB])
+    old = Engine(old_spec, 0.0)
+    old.on_message("/x", 1.0, {"data": 5.0})
+    new = Engine(new_spec, 2.0)
+    new.adopt(old, 2.0)
+    assert new.active_behaviours() == [1]  # carried by name: no second start
+    # the dispatcher keys it as the engine carries it, so the release reaches the runner that holds it
+    assert Dispatcher.keys(old_spec.behaviours)[1] == Dispatcher.keys(new_spec.behaviours)[1]
+    assert [e.kind for e in new.on_message("/x", 3.0, {"data": 0.0}) if e.kind != "rule"] == ["release"]
+    changed = check_text(text.format(2).replace("{ warn; }", '{ warn("other"); }'), os.path.join(ROOT, "s.rbs"), [LIB])
+    assert Dispatcher.keys(changed.behaviours)[1] != Dispatcher.keys(new_spec.behaviours)[1]  # other actions
