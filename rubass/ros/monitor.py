@@ -344,7 +344,7 @@ class Monitor(Reloading):
 
         def do(engine: Engine) -> int:
             events = engine.reset(now)
-            self.dispatcher.handle(engine, events, "reset")
+            self._on_events(events, "reset")  # a latched start it causes is written before it is dispatched
             n = len(self.dispatcher.orphans)
             self.dispatcher.release_orphans(now)
             n += self.overload.reset(now, self.dispatcher.runners)
