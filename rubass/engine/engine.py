@@ -75,11 +75,12 @@ class Engine:
         self.store = Store(now)
         self.orphans: List[Any] = []  # active behaviours of a replaced spec that this one lacks
         self.field_errors: Dict[Tuple[str, str], str] = {}
-        self._explainer: Optional[Explainer] = None
         # action -> [is active]; the holders: behaviour keys ('b:N') or outside holders (restored latches)
         self._active: Dict[str, List[bool]] = {a: [False] for a in spec.actions}
         self._holders: Dict[str, Set[str]] = {}
         self._compiler = Compiler(self.store, self._active)
+        self._explainer = Explainer(spec, self.store, lambda e: self._compiler._fn(e, [], None))
+        self._explainer.prepare()  # a start then only reads values (it is computed before dispatch)
         order = spec.evaluation or [r.key for r in spec.rules] + [f"b:{b.index}" for b in spec.behaviours]
         rules = {r.key: r for r in spec.rules}
         self._nodes: List[_Node] = []
@@ -432,9 +433,7 @@ class Engine:
         return sorted({k for k in keys if self.store.rules.get(k) is True})
 
     def explain(self, index: int) -> Witness:
-        """Why behaviour `index` (1-based) holds now: computed at its start only, off the message path."""
-        if self._explainer is None:
-            self._explainer = Explainer(self.spec, self.store, lambda e: self._compiler._fn(e, [], None))
+        """Why behaviour `index` (1-based) holds now: read at its start only, just before it is dispatched."""
         return self._explainer.explain(index)
 
     def active_behaviours(self) -> List[int]:

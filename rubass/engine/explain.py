@@ -1,6 +1,7 @@
 """Why a behaviour started: its true rules and the values they read, taken at the transition.
 
-A witness is computed only when a behaviour starts (never on the message path): the rules its
+A witness is computed only when a behaviour starts (never for a message that starts nothing),
+with readers compiled when the engine is built, so a start only reads values: the rules its
 condition uses, directly or through other rules, that are true at that instant, and every topic
 field and function value that the condition and those rules read, as the engine's store holds
 them then. Labels are written as in a spec without the `topic`/`node` keywords, so a safety
@@ -138,6 +139,13 @@ class Explainer:
         self.spec, self.store, self._compile = spec, store, compile_term
         self._rules = {r.key: r for r in spec.rules}
         self._readers: Dict[int, List[Tuple[str, str, Callable[[], Any]]]] = {}
+
+    def prepare(self) -> None:
+        """Compile every reader now (at build time), so that a start only reads values."""
+        for b in self.spec.behaviours:
+            self._readers_of(b.cond)
+        for r in self.spec.rules:
+            self._readers_of(r.expr)
 
     def explain(self, index: int) -> Witness:
         """The witness of behaviour `index` (1-based) at the store's current instant."""
