@@ -56,8 +56,10 @@ class Witness:
     name: str = ""  # the behaviour's name (§14), "" when unnamed
 
     def values(self) -> Dict[str, Any]:
-        """term -> value (None when unknown), as JSON shows them."""
-        return {r.term: r.value for r in self.readings}
+        """term -> value (None when unknown) as JSON shows them: valid JSON has no infinity, so an
+        infinite value (a laser's no-return, a division's limit) is the string "inf" or "-inf"."""
+        return {r.term: (("inf" if r.value > 0 else "-inf") if isinstance(r.value, float) and math.isinf(r.value)
+                         else r.value) for r in self.readings}
 
     def units(self) -> Dict[str, str]:
         return {r.term: r.unit for r in self.readings if r.unit}

@@ -8,7 +8,7 @@ from typing import Any, List, Tuple
 
 from . import ast
 from .geometry import polygon_problem
-from .units import DIMENSIONLESS, FREQUENCY, LENGTH, MEMORY, TIME, dim_mul
+from .units import COUNT, DIMENSIONLESS, FREQUENCY, LENGTH, MEMORY, TIME, dim_mul
 
 # Ty, BOOL, … live in typecheck; imported lazily there to avoid a cycle.
 
@@ -124,7 +124,7 @@ class BuiltinChecks:
         return replace(ref, path=ref.path[:i + 1]), ref.path[i + 1:]
 
     def _array_fn(self, e: ast.Call) -> Tuple[ast.Expr, Any]:
-        from .typecheck import ANY, BARE, num
+        from .typecheck import ANY, num
         arg = e.args[0]
         if not isinstance(arg, ast.TopicRef) or not arg.path:
             what = "an array field such as 'topic /scan.ranges'" if e.func == "len" else \
@@ -137,10 +137,10 @@ class BuiltinChecks:
         array, elem = self._array_term(arg)
         ety = self._field_ty(arg, array=True)  # type: ignore[attr-defined]
         out = ast.ArrayFn(e.func, array, elem, span=e.span)
-        return out, (BARE if e.func == "len" else num(ety.dim if ety.kind == "num" else None))
+        return out, (num(COUNT) if e.func == "len" else num(ety.dim if ety.kind == "num" else None))
 
     def _quantifier(self, e: ast.Call) -> Tuple[ast.Expr, Any]:
-        from .typecheck import ANY, BARE, BOOL, _Quant
+        from .typecheck import ANY, BOOL, _Quant, num
         self._dynamic_only(e)
         if len(e.args) != 1:
             self.error(e.span, f"{e.func}() takes one condition over an array, e.g. "  # type: ignore[attr-defined]
@@ -162,11 +162,14 @@ class BuiltinChecks:
                 self.error(sub.span, f"{word} cannot be used inside {e.func}(): an element has no history; "  # type: ignore[attr-defined]
                                      f"apply it to the quantifier instead, e.g. ({e.func}(…)) for 1 s")
                 return e, ANY
+        nested = any(isinstance(x, ast.Call) and x.func in ("any", "all", "count") for x in ast.walk(body))
+        if ctx.array is None and nested:
+            return e, ANY  # the nested quantifier has been reported: it is the mistake, not a missing array
         if ctx.array is None:
             self.error(e.span, f"{e.func}() needs an array term in its condition, such as "  # type: ignore[attr-defined]
                                        "'topic /diagnostics.status[*].level' or 'topic /scan.ranges[0:90]'")
             return e, ANY
-        return ast.Quant(e.func, ctx.array, body, span=e.span), (BARE if e.func == "count" else BOOL)
+        return ast.Quant(e.func, ctx.array, body, span=e.span), (num(COUNT) if e.func == "count" else BOOL)
 
     # -- logic over time and actions -------------------------------------------------------
     def _latch(self, e: ast.Call) -> Tuple[ast.Expr, Any]:

@@ -46,7 +46,10 @@ class _Checker:
         top: Dict[str, Span] = {}
         for d in self.spec.decls:
             if isinstance(d, ast.Behaviour) and d.name is not None:
-                if d.name.name in top:
+                if d.name.name in self.declared_names:  # tests and events name both: one must not hide the other
+                    self.error(d.name.span, f"behaviour name '{d.name.name}' is also the name of a declared "
+                                            "action: give the behaviour another name")
+                elif d.name.name in top:
                     self.error(d.name.span, f"duplicate name '{d.name.name}' (a behaviour); first defined at "
                                             f"{top[d.name.name]}")
                 else:

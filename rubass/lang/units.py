@@ -35,6 +35,8 @@ LENGTH = dim(m=1)
 SPEED = dim(m=1, s=-1)
 FREQUENCY = dim(s=-1)
 MEMORY = dim(B=1)
+# what count() and len() give: a number of things, compared with plain numbers only
+COUNT: Dimension = (("count", 1),)
 # the dimension of sqrt of an odd power (sqrt(1 m), sqrt(age(…))): no SI dimension matches it
 ODD: Dimension = (("sqrt of an odd power", 1),)
 VOLTAGE = dim(V=1)
@@ -88,6 +90,8 @@ UNITS: Dict[str, Tuple[float, Dimension]] = {
 
 def dimension_name(d: Dimension) -> str:
     """A readable name: 'time', 'speed', or a formula such as 'm^2'."""
+    if d == COUNT:
+        return "count"
     if d in _NAMES:
         return _NAMES[d]
     return "*".join(base if exp == 1 else f"{base}^{exp}" for base, exp in d)

@@ -92,6 +92,10 @@ CASES = [
      (3, 35, "the number '1e999' is too large")),
     ("for of a division by zero", HEAD + "entity e { rules: r: topic /v.x > 1 for (1 s / 0); }\nif (e.r) then { stop; }\n",
      (3, 46, "the duration of 'for' is not a number")),
+    ("a count compared with a length", HEAD + "entity e { rules: r: len(topic /d.status[*]) > 2 m; }\n"
+     "if (e.r) then { stop; }\n", (3, 46, "compares a count with a length")),
+    ("a behaviour named like an action", HEAD + "entity e { rules: r: topic /v.x > 1; }\n"
+     "warn: if (e.r) then { stop; }\n", (4, 1, "behaviour name 'warn' is also the name of a declared action")),
     ("sqrt of an odd power has no SI dimension", HEAD + "entity e { rules: r: sqrt(1 m) > 1 m; }\n"
      "if (e.r) then { stop; }\n", (3, 32, "compares a sqrt of an odd power with a length")),
     ("sqrt of a time compared with a time", HEAD + "entity e { rules: r: sqrt(age(topic /t)) > 1 s; }\n"
@@ -137,6 +141,16 @@ def test_fmt_round_trips_every_v2_construct(tmp_path):
     assert spec.behaviour("2").label == "behaviour 2" and spec.behaviour("overspeed").label == "overspeed"
     # one evaluation order: the behaviour that starts stop comes before the one reading active(stop)
     assert spec.evaluation.index("b:1") < spec.evaluation.index("b:2")
+
+
+def test_nested_quantifiers_are_reported_once_as_such(tmp_path):
+    got = errors(tmp_path, HEAD + "entity e { rules: r: any(any(topic /d.s[*].l > 1)); }\nif (e.r) then { stop; }\n")
+    assert [m for _, _, m in got] == ["quantifiers cannot be nested: any() inside any()"]
+
+
+def test_counts_compare_with_plain_numbers_and_their_ratios_with_shares(tmp_path):
+    ok(tmp_path, HEAD + "entity e { rules: r: count(topic /d.s[*].l > 1) >= 2 and "
+                        "count(topic /d.s[*].l > 1) / len(topic /d.s) > 50 %; }\nif (e.r) then { stop; }\n")
 
 
 def test_star_and_full_slice_are_one_thing():
@@ -196,3 +210,13 @@ def test_unreadable_bytes_are_shown_with_their_line_and_caret(tmp_path, data, co
     text = str(info.value).splitlines()
     assert text[0].startswith(f"{path}:1:{col}: error:")
     assert mark in text[1] and text[2].index("^") == text[1].index(mark)
+
+
+def test_a_witness_of_an_infinite_value_is_valid_json(tmp_path):
+    import json
+
+    spec = ok(tmp_path, HEAD + "entity e { rules: r: min(topic /s.r) > 1; }\nif (e.r) then { warn; }\n")
+    engine = Engine(spec, 0.0)
+    start = [e for e in engine.on_message("/s", 1.0, {"r": [float("inf")]}) if e.kind == "start"][0]
+    text = json.dumps(start.witness.as_json(), allow_nan=False)  # Infinity is not JSON
+    assert json.loads(text)["witnesses"] == {"min(/s.r)": "inf"}
