@@ -70,9 +70,11 @@ class _Node:
 class Engine:
     """Evaluates one checked spec over time."""
 
-    def __init__(self, spec: CheckedSpec, now: float) -> None:
+    def __init__(self, spec: CheckedSpec, now: float, origin: float = 0.0) -> None:
+        """`origin`: the absolute time at which `now` is 0, when times are given relative (replay):
+        header stamps are absolute, so stamp_age needs it."""
         self.spec = spec
-        self.store = Store(now)
+        self.store = Store(now, origin)
         self.orphans: List[Any] = []  # active behaviours of a replaced spec that this one lacks
         self.field_errors: Dict[Tuple[str, str], str] = {}
         # action -> [is active]; the holders: behaviour keys ('b:N') or outside holders (restored latches)

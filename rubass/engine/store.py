@@ -10,8 +10,9 @@ from .values import UNKNOWN
 
 
 class Store:
-    def __init__(self, now: float) -> None:
+    def __init__(self, now: float, origin: float = 0.0) -> None:
         self.now = now
+        self.origin = origin  # the absolute time of now = 0 (replay runs from 0; header stamps are absolute)
         self.fields: Dict[Tuple[str, Tuple[PathElem, ...]], Any] = {}
         self.rules: Dict[str, Any] = {}
         self.watch_start: Dict[str, float] = {}
@@ -84,7 +85,7 @@ class Store:
     def stamp_age(self, topic: str) -> Any:
         """now − header.stamp of the last message (§11); unknown before one, or for a zero stamp."""
         stamp = self.stamps.get(topic, UNKNOWN)
-        return UNKNOWN if stamp is UNKNOWN else self.now - stamp
+        return UNKNOWN if stamp is UNKNOWN else self.now + self.origin - stamp
 
     def age(self, topic: str) -> Any:
         last = self.last_arrival.get(topic, self.watch_start.get(topic))

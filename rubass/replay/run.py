@@ -17,7 +17,7 @@ def replay(spec: CheckedSpec, messages: Iterable[Tuple[float, str, Optional[Any]
     cpu, memory), fed to the engine as samples.
     """
     node_topics = set(node_topics)
-    engine = Engine(spec, 0.0)
+    engine = Engine(spec, 0.0, origin=start)  # times run from 0; header stamps stay absolute
     events = engine.evaluate_all(0.0)
     period = 1.0 / rate
     next_tick = period

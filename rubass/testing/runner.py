@@ -21,6 +21,10 @@ from .yamlpos import TestFileError
 
 NODE_TOPIC = "/rubass_test/node_samples"  # a pseudo topic: node samples as a monitor records them
 TICK_RATE = 50.0  # as `rubass replay` and the monitor's default tick
+# Test time 0 is this absolute time for the engine, so that a message at 0 s has a real header
+# stamp (a zero stamp is unknown, §11); events come back in test time.
+EPOCH = 1000.0
+STAMP = ("header", "stamp")
 
 
 @dataclass
@@ -83,12 +87,14 @@ def _stream(spec: CheckedSpec, case: Case, path: str, warnings: List[str]) -> Li
         msg = cls()
         try:
             if has_header(cls):
-                assign(msg, ("header", "stamp"), time)
+                assign(msg, ("header", "stamp"), EPOCH + time)
         except MessageError:
             pass
         for part in parts:
             try:
                 for fpath, value in part.assignments:
+                    if fpath == STAMP and isinstance(value, (int, float)) and value != 0:
+                        value = EPOCH + value  # test time; 0 stays the zero stamp
                     assign(msg, fpath, value)
             except MessageError as exc:
                 raise TestFileError(path, part.line, f"{topic} ({case.topics[topic].type_name}): {exc}") from None
@@ -98,7 +104,7 @@ def _stream(spec: CheckedSpec, case: Case, path: str, warnings: List[str]) -> Li
             raise TestFileError(path, parts[0].line, f"the message of {topic} at {time:g} s does not fit "
                                                      f"{case.topics[topic].type_name}: {exc}") from None
         if topic in names:
-            out.append((time, 0, names[topic], msg))
+            out.append((EPOCH + time, 0, names[topic], msg))
     state: Dict[str, Dict[str, Any]] = {}
     nodes = {_global(n): n for n in spec.nodes}
     for s in sorted(case.nodes, key=lambda s: s.time):
@@ -113,8 +119,8 @@ def _stream(spec: CheckedSpec, case: Case, path: str, warnings: List[str]) -> Li
         for key, value in (("alive", s.alive), ("cpu", s.cpu), ("memory", s.memory)):
             if value is not UNSET:
                 prev[key] = value
-        data = json.dumps({"node": node, "time": s.time, **prev})
-        out.append((s.time, -1, NODE_TOPIC, _Sample(data)))
+        data = json.dumps({"node": node, "time": EPOCH + s.time, **prev})
+        out.append((EPOCH + s.time, -1, NODE_TOPIC, _Sample(data)))
     out.sort(key=lambda x: (x[0], x[1]))  # samples before messages of the same instant
     return [(t, topic, msg) for t, _, topic, msg in out]
 
@@ -213,7 +219,7 @@ def execute(p: Prepared) -> Outcome:
     if not spec.nodes:
         stream = [x for x in stream if x[1] != NODE_TOPIC]
     end = case.end
-    _, events = replay(spec, stream, 0.0, end, TICK_RATE, [NODE_TOPIC] if spec.nodes else [])
+    _, events = replay(spec, stream, EPOCH, EPOCH + end, TICK_RATE, [NODE_TOPIC] if spec.nodes else [])
     out = Outcome(case.name, case.line, list(case.covers), duration=end)
     out.events = [e for e in events if e.kind in ("start", "release", "rule")]
     out.rules_true = {e.rule for e in events if e.kind == "rule" and e.value is True}

@@ -187,3 +187,24 @@ def test_named_behaviours_are_named_in_starts_releases_and_the_summary(write, tm
     events = [json.loads(x) for x in replay(spec, bag, "--json").stdout.splitlines()]
     assert [(e["event"], e.get("name")) for e in events if e.get("event") in ("start", "release")] == \
         [("start", "overspeed"), ("release", "overspeed")]
+
+
+def test_stamp_age_is_measured_against_the_recordings_own_time(write, tmp_path):
+    """Header stamps are absolute: a replay from the bag's start must still see them as old or fresh."""
+    from sensor_msgs.msg import Imu
+
+    items = []
+    for t, age in ((0.0, 0.0), (1.0, 0.0), (2.0, 1.0), (3.0, 0.0)):  # at 2 s the data is already 1 s old
+        m = Imu()
+        m.header.stamp = rospy.Time.from_sec(T0 + t - age)
+        items.append((t, "/imu", m))
+    bag = write_bag(str(tmp_path / "b.bag"), items)
+    spec = spec_file(write, "entity d { rules: stale: stamp_age(topic /imu) > 0.5 s; }\n"
+                            "stale_imu: if (d.stale) then { warn; }\n")
+    proc = replay(spec, bag, "--json")
+    assert proc.returncode == 0, proc.stderr
+    events = [json.loads(x) for x in proc.stdout.splitlines()]
+    got = [(e["event"], round(e["time"], 3)) for e in events if e.get("event") in ("start", "release")]
+    # stale 0.5 s after each fresh stamp (the data ages between messages too), still stale with the
+    # 1-second-old message at 2 s, fresh again at 3 s (the end of the recording)
+    assert got == [("start", 0.5), ("release", 1.0), ("start", 1.5), ("release", 3.0)], got
