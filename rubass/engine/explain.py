@@ -21,8 +21,6 @@ from .store import Store
 from .values import UNKNOWN
 
 # functions whose value is a pure read of the store (no state of their own), with their unit
-_UNITS = {"age": "s", "stamp_age": "s", "frequency": "Hz", "cpu": "cores", "memory": "B", "alive": ""}
-_ARRAY_FNS = ("min", "max", "len")
 
 
 @dataclass(frozen=True)
@@ -75,24 +73,21 @@ _NODE_UNITS = {"cpu": "cores", "memory": "B", "alive": ""}
 
 
 def _checked_label(e: ast.Expr) -> Optional[Tuple[str, str]]:
-    """(label, unit) of a checked built-in (version 2 AST), or None."""
-    A = ast
-    if isinstance(e, getattr(A, "Age", ())):
-        return f"age({e.topic})", "s"  # type: ignore[union-attr]
-    if isinstance(e, getattr(A, "StampAge", ())):
-        return f"stamp_age({e.topic})", "s"  # type: ignore[union-attr]
-    if isinstance(e, getattr(A, "Frequency", ())):
-        w = e.window  # type: ignore[union-attr]
-        return (f"frequency({e.topic})" if w == 1.0 else f"frequency({e.topic}, {w:g} s)"), "Hz"  # type: ignore[union-attr]
-    if isinstance(e, getattr(A, "NodeStat", ())):
-        return f"{e.attr}({e.node})", _NODE_UNITS.get(e.attr, "")  # type: ignore[union-attr]
-    if isinstance(e, getattr(A, "Rate", ())):
-        return f"rate({e.ref.topic}{e.ref.path_text})", "/s"  # type: ignore[union-attr]
-    if isinstance(e, getattr(A, "ArrayFn", ())):
-        ref = e.ref  # type: ignore[union-attr]
-        return f"{e.func}({ref.topic}{ref.path_text}{ast.path_suffix(e.elem)})", ""  # type: ignore[union-attr]
-    if isinstance(e, getattr(A, "Active", ())):
-        return f"active({e.action})", ""  # type: ignore[union-attr]
+    """(label, unit) of a checked built-in, or None for what is not a reading of its own."""
+    if isinstance(e, ast.Age):
+        return f"age({e.topic})", "s"
+    if isinstance(e, ast.StampAge):
+        return f"stamp_age({e.topic})", "s"
+    if isinstance(e, ast.Frequency):
+        return (f"frequency({e.topic})" if e.window == 1.0 else f"frequency({e.topic}, {e.window:g} s)"), "Hz"
+    if isinstance(e, ast.NodeStat):
+        return f"{e.attr}({e.node})", _NODE_UNITS.get(e.attr, "")
+    if isinstance(e, ast.Rate):
+        return f"rate({e.ref.topic}{e.ref.path_text})", "/s"
+    if isinstance(e, ast.ArrayFn):
+        return f"{e.func}({e.ref.topic}{e.ref.path_text}{ast.path_suffix(e.elem)})", ""
+    if isinstance(e, ast.Active):
+        return f"active({e.action})", ""
     return None
 
 
@@ -101,23 +96,7 @@ def label(e: ast.Expr) -> Optional[str]:
     if isinstance(e, ast.TopicRef):
         return e.topic + e.path_text
     checked = _checked_label(e)
-    if checked is not None:
-        return checked[0]
-    if isinstance(e, ast.Call) and (e.func in _UNITS or e.func in _ARRAY_FNS):
-        if e.func in _ARRAY_FNS and (len(e.args) != 1 or not isinstance(e.args[0], ast.TopicRef)):
-            return None  # min(x, y): arithmetic, its operands are readings of their own
-        parts: List[str] = []
-        for a in e.args:
-            if isinstance(a, ast.TopicRef):
-                parts.append(a.topic + a.path_text)
-            elif isinstance(a, ast.NodeRef):
-                parts.append(a.node)
-            elif isinstance(a, ast.Lit) and isinstance(a.value, float):
-                parts.append(f"{a.value:g} s")
-            else:
-                return None
-        return f"{e.func}({', '.join(parts)})"
-    return None
+    return checked[0] if checked is not None else None
 
 
 def _json_value(v: Any) -> Any:
@@ -198,9 +177,7 @@ class Explainer:
                 fn = self._compile(e)
             except Exception:  # a construct this explainer cannot read alone: leave it out
                 continue
-            checked = _checked_label(e)
-            unit = checked[1] if checked is not None else _UNITS.get(getattr(e, "func", ""), "")
-            out.append((term, unit, fn))
+            out.append((term, _checked_label(e)[1], fn))  # type: ignore[index]
         self._readers[key] = out
         return out
 
@@ -215,7 +192,7 @@ def _terms(expr: ast.Expr) -> Sequence[ast.Expr]:
     out: List[ast.Expr] = []
 
     def visit(e: ast.Expr) -> None:
-        if (isinstance(e, ast.Call) or _checked_label(e) is not None) and label(e) is not None:
+        if _checked_label(e) is not None:
             out.append(e)
             return
         if type(e).__name__ == "Quant":

@@ -77,7 +77,10 @@ def test_releases_and_rule_events_carry_no_witness():
 
 def test_labels():
     assert label(ast.TopicRef("/scan", ("ranges", 0))) == "/scan.ranges[0]"
-    assert label(ast.Call("frequency", (ast.TopicRef("/odom"), ast.Lit(2.0)))) == "frequency(/odom, 2 s)"
+    assert label(ast.Frequency("/odom", 2.0)) == "frequency(/odom, 2 s)"
+    assert label(ast.Age("/cmd_vel")) == "age(/cmd_vel)"
+    assert label(ast.ArrayFn("min", ast.TopicRef("/scan", ("ranges", ast.Slice(0, 90))))) == "min(/scan.ranges[0:90])"
+    assert label(ast.Call("min", (ast.Lit(1.0), ast.Lit(2.0)))) is None  # arithmetic: its operands are read
 
 
 def test_witnesses_cost_nothing_on_the_message_path():
