@@ -195,7 +195,7 @@ def _terms(expr: ast.Expr) -> Sequence[ast.Expr]:
         if _checked_label(e) is not None:
             out.append(e)
             return
-        if type(e).__name__ == "Quant":
+        if isinstance(e, ast.Quant):
             return  # its body reads one element at a time: no single value to show
         if isinstance(e, ast.TopicRef):
             if e.path:
