@@ -8,18 +8,20 @@ from __future__ import annotations
 
 from typing import Any, Callable, Dict, List, Sequence
 
-from .base import Context
-
-KEY = ("rubass-data-error", 0)  # the runners' identity for this pseudo-behaviour
-Log = Callable[[str, str], None]
-Report = Callable[[Dict[str, Any]], None]
+from .failsafe import FailSafe, Log, Report
 
 
-class ErrorGuard:
+class ErrorGuard(FailSafe):
+    key = ("rubass-data-error", 0)
+    rule = "monitor.data_error"
+    cause = "data error"
+
     def __init__(self, actions: Sequence[str], log: Log, report: Report) -> None:
-        self.actions, self.log, self.report = list(actions), log, report
-        self.active = False
+        super().__init__(actions, log, report)
         self.errors: List[str] = []
+
+    def released_text(self, why: str) -> str:
+        return f"{why}: releasing {', '.join(self.actions)} (~error_actions)"
 
     def check(self, errors: List[str], now: float, runners: Dict[str, Any], latched: Callable[[str], bool]) -> None:
         """On the engine's thread, at each tick, with the data errors that exist now."""
@@ -34,24 +36,9 @@ class ErrorGuard:
         elif self.active:
             self._send("hold", now, runners)
 
-    def release(self, now: float, runners: Dict[str, Any], why: str) -> None:
-        if self.active:
-            self.active = False
-            self.log("warn", f"{why}: releasing {', '.join(self.actions)} (~error_actions)")
-            self._send("release", now, runners)
-
     def reset(self, now: float, runners: Dict[str, Any]) -> bool:
         """~reset: release latched error actions once no error is left; whether it did."""
         if self.active and not self.errors:
             self.release(now, runners, "reset")
             return True
         return False
-
-    def _send(self, kind: str, now: float, runners: Dict[str, Any]) -> None:
-        for name in self.actions:
-            runner = runners.get(name)
-            if runner is not None:
-                runner.submit(kind, Context(0, 0, ("monitor.data_error",), (), now, KEY))
-        if kind != "hold":
-            self.report({"time": now, "event": kind, "behaviour": 0, "line": 0, "actions": self.actions,
-                         "rules": ["monitor.data_error"], "cause": "data error", "latency_ms": None})

@@ -9,19 +9,22 @@ from __future__ import annotations
 
 from typing import Any, Callable, Dict, Optional, Sequence
 
-from .base import Context
-
-KEY = ("rubass-overload", 0)  # the runners' identity for this pseudo-behaviour
-Log = Callable[[str, str], None]
-Report = Callable[[Dict[str, Any]], None]
+from .failsafe import FailSafe, Log, Report
 
 
-class OverloadGuard:
+class OverloadGuard(FailSafe):
+    key = ("rubass-overload", 0)
+    rule = "monitor.overloaded"
+    cause = "overload"
+
     def __init__(self, actions: Sequence[str], calm: float, log: Log, report: Report) -> None:
-        self.actions, self.calm, self.log, self.report = list(actions), calm, log, report
-        self.active = False
+        super().__init__(actions, log, report)
+        self.calm = calm
         self._seen = 0  # drops already accounted for
         self._last_drop = 0.0
+
+    def released_text(self, why: str) -> str:
+        return f"overload over ({why}): releasing {', '.join(self.actions)}"
 
     def check(self, dropped: int, now: float, runners: Dict[str, Any], latched: Callable[[str], bool],
               by_topic: Optional[Dict[str, int]] = None) -> None:
@@ -48,27 +51,12 @@ class OverloadGuard:
         """Whether check() with this drop count starts the fail-safe actions."""
         return dropped > self._seen and not self.active and bool(self.actions)
 
-    def release(self, now: float, runners: Dict[str, Any], why: str) -> None:
-        if self.active:
-            self.active = False
-            self.log("warn", f"overload over ({why}): releasing {', '.join(self.actions)}")
-            self._send("release", now, runners)
-
     def reset(self, now: float, runners: Dict[str, Any]) -> bool:
         """~reset: release latched fail-safe actions once calm; whether it did."""
         if self.active and now - self._last_drop >= self.calm:
             self.release(now, runners, "reset")
             return True
         return False
-
-    def _send(self, kind: str, now: float, runners: Dict[str, Any]) -> None:
-        for name in self.actions:
-            runner = runners.get(name)
-            if runner is not None:
-                runner.submit(kind, Context(0, 0, ("monitor.overloaded",), (), now, KEY))
-        if kind != "hold":
-            self.report({"time": now, "event": kind, "behaviour": 0, "line": 0, "actions": self.actions,
-                         "rules": ["monitor.overloaded"], "cause": "overload", "latency_ms": None})
 
 
 
