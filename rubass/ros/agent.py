@@ -32,32 +32,13 @@ from urllib.parse import urlparse
 
 import psutil
 
-from ..lang.errors import RubassError
 from ..engine.values import UNKNOWN
-from ..lang.units import FREQUENCY, parse_quantity
 from . import rpc
 from .agentbook import AGENT_TOPIC, encode, is_loopback, node_entry
 from .nodes import NodeSampler, NodeStatus
+from .params import ParamError, read_rate
 
 Log = Callable[[str, str], None]
-
-
-class AgentParamError(RubassError):
-    """A bad parameter of the agent; the message names it."""
-
-
-def read_rate(get: Callable[[str, Any], Any], name: str, default: float, lo: float, hi: float) -> float:
-    """A rate parameter (a number of Hz or e.g. '10 Hz'), or AgentParamError."""
-    value = get(name, default)
-    q = None
-    if isinstance(value, (int, float)) and not isinstance(value, bool):
-        q = (float(value), FREQUENCY)
-    elif isinstance(value, str):
-        q = parse_quantity(value)
-    if q is None or (q[1] and q[1] != FREQUENCY) or not lo <= q[0] <= hi:
-        raise AgentParamError(f"~{name} must be a rate from {lo:g} to {hi:g} Hz (a number or e.g. '10 Hz'), "
-                              f"got {value!r}")
-    return q[0]
 
 
 def host_addresses() -> List[str]:
@@ -173,7 +154,7 @@ def main(argv: Optional[List[str]] = None) -> int:
         get = lambda name, default: rospy.get_param("~" + name, default)  # noqa: E731
         rate = read_rate(get, "node_rate", 10.0, 0.1, 100.0)
         discover_period = 1.0 / read_rate(get, "discover_rate", 1.0, 0.01, 100.0)
-    except AgentParamError as exc:
+    except ParamError as exc:
         rospy.logfatal("rubass agent: cannot start: %s", exc)
         print(f"rubass agent: cannot start: {exc}", file=sys.stderr)
         return 1

@@ -5,13 +5,14 @@ import os
 from dataclasses import dataclass, field
 from typing import Any, Callable, List, Optional
 
+from ..lang.errors import RubassError
 from ..lang.units import FREQUENCY, parse_quantity
 
 Getter = Callable[[str, Any], Any]
 _MISSING = object()
 
 
-class ParamError(Exception):
+class ParamError(RubassError):
     """A missing or bad parameter; the message names it and says what is expected."""
 
 
@@ -29,7 +30,8 @@ class MonitorConfig:
     error_actions: List[str] = field(default_factory=list)  # run while a field cannot be read
 
 
-def _rate(get: Getter, name: str, default: float, lo: float, hi: float) -> float:
+def read_rate(get: Getter, name: str, default: float, lo: float, hi: float) -> float:
+    """A rate parameter (a number of Hz, or e.g. '10 Hz') from lo to hi, or ParamError."""
     value = get(name, default)
     q = None
     if isinstance(value, (int, float)) and not isinstance(value, bool):
@@ -37,7 +39,7 @@ def _rate(get: Getter, name: str, default: float, lo: float, hi: float) -> float
     elif isinstance(value, str):
         q = parse_quantity(value)
     if q is None or (q[1] and q[1] != FREQUENCY) or not lo <= q[0] <= hi:
-        raise ParamError(f"~{name} must be a rate from {lo:g} to {hi:g} Hz (a number or e.g. '50 Hz'), "
+        raise ParamError(f"~{name} must be a rate from {lo:g} to {hi:g} Hz (a number or e.g. '10 Hz'), "
                          f"got {value!r}")
     return q[0]
 
@@ -80,10 +82,10 @@ def read_config(get: Getter, default_state_file: Optional[str] = None) -> Monito
     return MonitorConfig(
         spec=os.path.expanduser(spec),
         actions=[os.path.expanduser(a) for a in actions],
-        rate=_rate(get, "rate", 50.0, 1.0, 1000.0),
-        node_rate=_rate(get, "node_rate", 10.0, 0.1, 100.0),
-        diagnostics_rate=_rate(get, "diagnostics_rate", 1.0, 0.1, 10.0),
-        master_rate=_rate(get, "master_rate", 4.0, 0.1, 100.0),
+        rate=read_rate(get, "rate", 50.0, 1.0, 1000.0),
+        node_rate=read_rate(get, "node_rate", 10.0, 0.1, 100.0),
+        diagnostics_rate=read_rate(get, "diagnostics_rate", 1.0, 0.1, 10.0),
+        master_rate=read_rate(get, "master_rate", 4.0, 0.1, 100.0),
         overload_actions=overload,
         queue_size=queue_size,
         state_file=_state_file(get, default_state_file),
