@@ -12,7 +12,7 @@ from __future__ import annotations
 import heapq
 import itertools
 from dataclasses import dataclass
-from typing import Any, Dict, FrozenSet, Iterable, List, Optional, Set, Tuple
+from typing import AbstractSet, Any, Dict, FrozenSet, Iterable, List, Optional, Set, Tuple
 
 from ..lang import ast
 from ..lang.model import CheckedBehaviour, CheckedSpec
@@ -248,14 +248,14 @@ class Engine:
         self.store.nodes[node] = {"alive": alive, "cpu": cpu, "memory": memory}
         plan = self._node_plans.get(node)
         if plan:
-            self._run(plan, events)
+            self._run(plan, events, _NO_FIELDS)
         events += self.advance(now)
         return events
 
     def on_tick(self, now: float) -> List[Event]:
         """A scheduler tick: time-dependent expressions, then `hold` of every active behaviour."""
         events = self.advance(now)
-        self._run(self._tick_plan, events)
+        self._run(self._tick_plan, events, _NO_FIELDS)
         for node in self._nodes:
             if node.active:
                 events.append(self._event(node, "hold"))
@@ -280,7 +280,7 @@ class Engine:
                 break
             _, _, idx, _ = heapq.heappop(self._heap)
             self.store.now = max(self.store.now, due)
-            self._run(self._plan((idx,)), events)
+            self._run(self._plan((idx,)), events, _NO_FIELDS)
         self.store.now = max(self.store.now, now)
         return events
 
@@ -448,9 +448,9 @@ class Engine:
         return Event(self.store.now, kind, b.index, actions=node.actions, line=b.span.line, name=b.name,
                      witness=witness)
 
-    def _run(self, plan: Tuple[int, ...], events: List[Event], changed: Optional[Set[Any]] = None) -> None:
-        """Evaluate the plan's nodes in order. After a message (`changed`: the field slots it
-        changed), a node that is not volatile is skipped when neither a field it reads nor a
+    def _run(self, plan: Tuple[int, ...], events: List[Event], changed: Optional[AbstractSet[int]] = None) -> None:
+        """Evaluate the plan's nodes in order. After a message, a tick, a deadline or a node
+        sample (`changed`: the numbers of the field slots it changed, if any), a node that is not volatile is skipped when neither a field it reads nor a
         node it reads changed value: it would give the value it has."""
         store, nodes = self.store, self._nodes
         moved: Set[int] = set()  # nodes whose value changed in this run
@@ -502,6 +502,7 @@ class Engine:
 
 
 STAMP: Tuple[ast.PathElem, ...] = ("header", "stamp")
+_NO_FIELDS: FrozenSet[int] = frozenset()  # a tick, a deadline, a node sample: no field changed
 
 
 def _stamp(value: Any) -> Any:

@@ -12,7 +12,7 @@ from conftest import ROOT
 LIB = os.path.join(ROOT, "docs", "examples", "actions.yaml")
 
 SPEC = """action primitive stop, warn;
-entity r { rules:
+entity r: /p; { rules:
   a: topic /x.v > 1;
   b: topic /y.v < 0 or a;
   c: (topic /x.v > 2) for 0.2 s;
@@ -24,10 +24,13 @@ entity r { rules:
   i: (topic /x.v + topic /y.v > 1) within 0.3 s;
   j: active(warn) and topic /y.v > 0;
   k: topic /x.w == "on";
+  n: cpu(node /p) > 0.5 and topic /y.v > 0;
+  m: n or a;
 }
 if (r.d or r.e) then { warn; }
 if (r.j or r.g) then { stop; }
 if (r.f and r.k) then { stop; }
+if (r.m and not r.d) then { warn; }
 """
 
 
@@ -43,6 +46,8 @@ def _feed(engine, seq):
     for t, topic, msg in seq:
         if topic is None:
             out += engine.on_tick(t)
+        elif topic == "node":
+            out += engine.on_node_sample("/p", t, True, msg)
         else:
             out += engine.on_message(topic, t, msg)
     return [(e.time, e.kind, e.behaviour, e.rule, e.value) for e in out]
@@ -60,6 +65,8 @@ def test_incremental_evaluation_gives_the_events_of_full_evaluation():
                 seq.append((t, "/x", {"v": rnd.choice([0, 1.5, 2.2, 3, float("nan")]), "w": rnd.choice(["on", "off"])}))
             elif kind < 0.7:
                 seq.append((t, "/y", {"v": rnd.choice([-2, -0.5, 0, 0.5])}))
+            elif kind < 0.8:
+                seq.append((t, "node", rnd.choice([0.2, 0.7])))
             elif kind < 0.9:
                 seq.append((t, "/s", {"r": tuple(rnd.choice([0.5, 1.5, 3.0]) for _ in range(rnd.choice([2, 4])))}))
             else:
