@@ -70,10 +70,18 @@ def _laser(pick: Callable[..., float], ranges: Any, lim: Tuple[float, float]) ->
             best = pick(ranges)
             if lo <= best <= hi:  # the extreme itself is a valid reading, so it is the answer
                 return float(best)
-    valid = [v for v in ranges if lo <= v <= hi]
-    if -math.inf in ranges:
-        valid.append(0.0)
-    return float(pick(valid)) if valid else UNKNOWN
+    # With NaN, iterate in C still: the least reading >= range_min (NaN, -inf fail the test) is the
+    # answer when it is <= range_max (+inf and the readings above are never the least of those);
+    # for max the other way round.
+    if pick is min:
+        best = min(filter(lo.__le__, ranges), default=None)
+        best = best if best is not None and best <= hi else None
+    else:
+        best = max(filter(hi.__ge__, ranges), default=None)
+        best = best if best is not None and best >= lo else None
+    if -math.inf in ranges:  # too close to measure: 0 m
+        best = 0.0 if best is None else pick(best, 0.0)
+    return UNKNOWN if best is None else float(best)
 
 
 def quantifier(name: str, read: Fn, cell: List[Any], body: Fn) -> Fn:
