@@ -450,8 +450,9 @@ class Engine:
 
     def _run(self, plan: Tuple[int, ...], events: List[Event], changed: Optional[AbstractSet[int]] = None) -> None:
         """Evaluate the plan's nodes in order. After a message, a tick, a deadline or a node
-        sample (`changed`: the numbers of the field slots it changed, if any), a node that is not volatile is skipped when neither a field it reads nor a
-        node it reads changed value: it would give the value it has."""
+        sample (`changed`: the numbers of the field slots it changed, if any), a node that is
+        not volatile is skipped when neither a field it reads nor a node it reads changed
+        value: it would give the value it has. With `changed` None, every node is evaluated."""
         store, nodes = self.store, self._nodes
         moved: Set[int] = set()  # nodes whose value changed in this run
         for i in plan:
