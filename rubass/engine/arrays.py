@@ -65,11 +65,11 @@ def _laser(pick: Callable[..., float], ranges: Any, lim: Tuple[float, float]) ->
     if not isinstance(ranges, tuple):
         return UNKNOWN
     if ranges:
-        total = sum(ranges)  # NaN when a reading is NaN (or both infinities): min/max unreliable then
-        if total == total:  # C speed for the usual scan: readings in range plus +inf for no return
-            best = pick(ranges)
-            if lo <= best <= hi:  # the extreme itself is a valid reading, so it is the answer
-                return float(best)
+        # C speed for the usual scan. min/max skip a NaN unless it comes first (then they return
+        # it, and it fails the test below); so an extreme within the limits is the answer.
+        best = pick(ranges)
+        if lo <= best <= hi:
+            return float(best)
     # With NaN, iterate in C still: the least reading >= range_min (NaN, -inf fail the test) is the
     # answer when it is <= range_max (+inf and the readings above are never the least of those);
     # for max the other way round.
