@@ -63,15 +63,8 @@ class HostSampler(NodeSampler):
         uri = self._uris.get(st.resolved)
         if uri is None:
             return UNKNOWN, None, "not discovered yet"
-        try:
-            code, msg, pid = rpc.proxy(uri, self.timeout).getPid(self.caller_id)
-        except socket.timeout:
-            return False, None, f"did not answer getPid within {self.timeout * 1000:.0f} ms (hung?)"
-        except (OSError, xmlrpc.client.Error, ValueError) as exc:
-            return False, None, f"does not answer at {uri}: {exc}"
-        if code != 1:
-            return False, None, f"getPid failed: {msg}"
-        return True, int(pid), "alive"
+        pid, why = self._pid_at(uri)
+        return (False, None, why) if pid is None else (True, pid, "alive")
 
 
 class Agent:

@@ -117,6 +117,19 @@ class NodeSampler:
         st.alive, st.cpu, st.memory, st.pid, st.why = alive, cpu, memory, pid, why
         self.submit(st.spec_name, self.now(), alive, cpu, memory)
 
+    def _pid_at(self, uri: str) -> Tuple[Optional[int], str]:
+        """The pid of the process answering at a node's URI, or None and why not (a hung node
+        is found by the timeout: its kernel still accepts the connection)."""
+        try:
+            code, msg, pid = rpc.proxy(uri, self.timeout).getPid(self.caller_id)
+        except socket.timeout:
+            return None, f"did not answer getPid within {self.timeout * 1000:.0f} ms (hung?)"
+        except (OSError, xmlrpc.client.Error, ValueError) as exc:
+            return None, f"does not answer at {uri}: {exc}"
+        if code != 1:
+            return None, f"getPid failed: {msg}"
+        return int(pid), ""
+
     def _ask(self, st: NodeStatus) -> Tuple[Any, Optional[int], str]:
         name = st.resolved
         note = ""
@@ -135,14 +148,9 @@ class NodeSampler:
             # the master is down, or restarted and does not know the node (rospy nodes do not
             # re-register): ask the node where it was; alive only if it is the same process
             note = " (the master cannot be reached)" if code == -2 else " (not registered with the master: restarted?)"
-        try:
-            code, msg, pid = rpc.proxy(uri, self.timeout).getPid(self.caller_id)
-        except socket.timeout:
-            return False, None, f"did not answer getPid within {self.timeout * 1000:.0f} ms (hung?)"
-        except (OSError, xmlrpc.client.Error, ValueError) as exc:
-            return False, None, f"does not answer at {uri}: {exc}"
-        if code != 1:
-            return False, None, f"getPid failed: {msg}"
+        pid, why = self._pid_at(uri)
+        if pid is None:
+            return False, None, why
         known = self._pids.get(name)
         if note and known is not None and int(pid) != known:
             return False, None, f"another process (pid {pid}) answers at {uri}{note}"
