@@ -9,5 +9,5 @@ except ImportError:  # plain setuptools, outside a catkin build
 
 setup(**generate_distutils_setup(
     packages=["rubass", "rubass.lang", "rubass.engine", "rubass.replay", "rubass.ros", "rubass.ros.actions",
-              "rubass.experiments", "rubass.actions", "rubass.testing", "rubass.report"],
+              "rubass_experiments", "rubass.actions", "rubass.testing", "rubass.report"],
 ))

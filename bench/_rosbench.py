@@ -5,8 +5,8 @@ import subprocess
 import sys
 
 import _common
-from rubass.experiments.master import PrivateMaster, stop_processes, wait_for_service
-from rubass.experiments.procs import supervise_script
+from rubass_experiments.master import PrivateMaster, stop_processes, wait_for_service
+from rubass_experiments.procs import supervise_script
 
 # a benchmark is a command that starts processes: SIGINT/SIGTERM/SIGHUP run its `finally` blocks and
 # exit 128+n, and whatever it started dies with it even when it is SIGKILLed (issue 19)

@@ -22,7 +22,7 @@ import warnings
 
 import _common
 from _rosbench import PY, PrivateMaster, stop_processes
-from rubass.experiments.master import wait_for_service
+from rubass_experiments.master import wait_for_service
 
 HERE = os.path.abspath(__file__)
 PATHS = {"raw": ("/bench/raw", "/bench/raw"), "relay": ("/bench/relay_in", "/bench/relay_out"),

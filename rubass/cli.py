@@ -10,7 +10,7 @@ from .lang import SpecError, format_spec, load_spec, parse_source
 from .replay.command import register as register_replay
 from .testing.command import register as register_test
 from .report.command import register as register_report
-from .experiments.command import register as register_experiments
+from rubass_experiments.command import register as register_experiments
 from .ros.model_command import add_source_options, build_model
 from .ros.libtypes import after_check, after_failed_check
 from .ros.model_command import register as register_model

@@ -20,7 +20,7 @@ fi
 export PYTHONDONTWRITEBYTECODE=1
 echo "== Python 3.8 compatibility (vermin)"
 "$VENV/bin/vermin" -q --no-tips --target=3.8- --violations --eval-annotations --backport typing \
-  --exclude-regex '\.venv' rubass scripts bench test
+  --exclude-regex '\.venv' rubass rubass_experiments scripts bench test
 
 echo "== pure tests with pyparsing 2.4.7"
 "$VENV/bin/python" -m pytest -q -p no:cacheprovider -m "not ros" test/unit

@@ -19,8 +19,8 @@ class Ros:
     def __init__(self, tmp_path):
         if not os.path.exists("/usr/bin/rosmaster"):
             pytest.skip("ROS 1 is not installed (rosmaster)")
-        from rubass.experiments.master import PrivateMaster
-        from rubass.experiments.procs import Supervisor
+        from rubass_experiments.master import PrivateMaster
+        from rubass_experiments.procs import Supervisor
 
         self.tmp = tmp_path
         # every process of the test carries its marker (self.env): if pytest is killed (SIGTERM from a
@@ -86,7 +86,7 @@ class Ros:
         return open(proc.log_path).read() if os.path.exists(proc.log_path) else ""
 
     def stop(self):
-        from rubass.experiments.master import stop_processes
+        from rubass_experiments.master import stop_processes
 
         try:
             stop_processes(list(reversed(self.procs)))

@@ -85,7 +85,7 @@ class Cluster:
         return "\n".join(f"--- {p.args[3:6]}\n{self.log(p)[-1500:]}" for p in self.procs)
 
     def stop(self):
-        from rubass.experiments.master import stop_processes
+        from rubass_experiments.master import stop_processes
 
         for host in list(self.net.cut_hosts):  # nodes unregister from the master as they stop
             self.net.mend(host)

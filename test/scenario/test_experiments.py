@@ -69,13 +69,13 @@ def test_the_board_stops_the_motors_when_the_monitor_dies(ros, tmp_path):
     import signal
     import time
 
-    from rubass.experiments.eventlog import read_events
+    from rubass_experiments.eventlog import read_events
 
     events = tmp_path / "events.jsonl"
     board = tmp_path / "board"
-    base = ros.spawn([sys.executable, "-m", "rubass.experiments.frobit", "__name:=frobit_base",
+    base = ros.spawn([sys.executable, "-m", "rubass_experiments.frobit", "__name:=frobit_base",
                       f"_events_file:={events}", f"_board_port:={board}"], "base")
-    ros.spawn([sys.executable, "-m", "rubass.experiments.driver", "__name:=controller", "_robot:=frobit"], "driver")
+    ros.spawn([sys.executable, "-m", "rubass_experiments.driver", "__name:=controller", "_robot:=frobit"], "driver")
     lib = (tmp_path / "lib.yaml")
     lib.write_text(f'actions:\n  board_stop: {{plugin: serial, port: {board}, on_start: "S\\n", latch: true}}\n')
     spec = tmp_path / "s.rbs"

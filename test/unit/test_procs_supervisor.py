@@ -1,4 +1,4 @@
-"""The process Supervisor (rubass/experiments/procs.py) with plain `sleep` children, no ROS: stop
+"""The process Supervisor (rubass_experiments/procs.py) with plain `sleep` children, no ROS: stop
 signals become one Interrupted, children die with a SIGKILLed parent (PDEATHSIG for the ones
 it spawned, the reaper for one started otherwise), a clean exit stops everything."""
 import os
@@ -12,7 +12,7 @@ import uuid
 import pytest
 
 from conftest import ROOT
-from rubass.experiments.procs import Interrupted, Supervisor
+from rubass_experiments.procs import Interrupted, Supervisor
 
 MARK = "RUBASS_PROCS_TEST"
 
@@ -38,7 +38,7 @@ def _run_child(body, mark):
     code = textwrap.dedent("""
         import os, subprocess, sys, time
         sys.path.insert(0, %r)
-        from rubass.experiments.procs import Supervisor, Interrupted
+        from rubass_experiments.procs import Supervisor, Interrupted
         sup = Supervisor()
         with sup:
         %s
@@ -124,7 +124,7 @@ def test_an_inherited_ignore_is_kept(mark):
     assert child.stdout.readline().strip() == "False"
     out = subprocess.run([sys.executable, "-c", f"import sys; sys.path.insert(0, {ROOT!r})\n"
                           "import signal\nsignal.signal(signal.SIGHUP, signal.SIG_IGN)\n"
-                          "from rubass.experiments.procs import Supervisor\nwith Supervisor():\n"
+                          "from rubass_experiments.procs import Supervisor\nwith Supervisor():\n"
                           "    print(signal.getsignal(signal.SIGHUP) is signal.SIG_IGN)"],
                          capture_output=True, text=True, timeout=30)
     assert out.stdout.strip() == "True", out.stderr

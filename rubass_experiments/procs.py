@@ -196,8 +196,8 @@ class Supervisor:
 
     # -- the reaper ----------------------------------------------------------------------
     def _start_reaper(self) -> None:
-        root = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))  # the checkout
-        code = f"import sys; sys.path.insert(0, {root!r}); from rubass.experiments.procs import reap; reap({self.marker!r})"
+        root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))  # the checkout
+        code = f"import sys; sys.path.insert(0, {root!r}); from rubass_experiments.procs import reap; reap({self.marker!r})"
         self._reaper = subprocess.Popen([sys.executable, "-c", code], stdin=subprocess.PIPE, env=self.env(),
                                         stdout=subprocess.DEVNULL, start_new_session=True, text=True)
 

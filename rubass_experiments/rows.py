@@ -18,7 +18,7 @@ class Row:
     paper: Optional[Tuple[float, float, float, float]]  # Avg, SD, Min, Max; None: not a row of the paper
     note: str = ""
     until: str = "stop_received"   # event that ends the reaction (a) and the wait
-    world: bool = False            # with the obstacle, laser and bumper (rubass.experiments.world)
+    world: bool = False            # with the obstacle, laser and bumper (rubass_experiments.world)
     behaviour: str = ""            # the behaviour whose start (b) is measured from; "": the first
 
 

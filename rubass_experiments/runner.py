@@ -23,10 +23,10 @@ import time
 from dataclasses import asdict, dataclass, field
 from typing import Any, Dict, List, Optional, Tuple
 
-from ..lang import load_spec
-from ..replay.run import replay
+from rubass.lang import load_spec
+from rubass.replay.run import replay
 from .rows import Row
-from ..ros.bag import BagError, open_bag, read
+from rubass.ros.bag import BagError, open_bag, read
 from .master import ROOT, PrivateMaster, wait_for_service
 from .eventlog import read_events
 from .procs import Interrupted, Supervisor
@@ -137,16 +137,16 @@ def run_once(session: Session, row: Row, rep: int) -> RunResult:
 
     ev = f"_events_file:={events_file}"
     if row.robot == "kobuki":
-        spawn("base", [PY, "-m", "rubass.experiments.kobuki", "__name:=mobile_base", ev])
+        spawn("base", [PY, "-m", "rubass_experiments.kobuki", "__name:=mobile_base", ev])
         if row.world:
-            spawn("world", [PY, "-m", "rubass.experiments.world", "__name:=world", ev])
-        spawn("injector", [PY, "-m", "rubass.experiments.injector", "__name:=fault_injector", ev])
-        spawn("driver", [PY, "-m", "rubass.experiments.driver", "__name:=controller", "_robot:=kobuki", ev,
+            spawn("world", [PY, "-m", "rubass_experiments.world", "__name:=world", ev])
+        spawn("injector", [PY, "-m", "rubass_experiments.injector", "__name:=fault_injector", ev])
+        spawn("driver", [PY, "-m", "rubass_experiments.driver", "__name:=controller", "_robot:=kobuki", ev,
                          "_goal_x:=2.5", "_goal_y:=1.0"])
     else:
-        spawn("base", [PY, "-m", "rubass.experiments.frobit", "__name:=frobit_base", ev,
+        spawn("base", [PY, "-m", "rubass_experiments.frobit", "__name:=frobit_base", ev,
                        f"_board_port:={os.path.join(run_dir, 'board')}", f"_seed:={rep}"])
-        spawn("driver", [PY, "-m", "rubass.experiments.driver", "__name:=controller", "_robot:=frobit", ev,
+        spawn("driver", [PY, "-m", "rubass_experiments.driver", "__name:=controller", "_robot:=frobit", ev,
                          "_goal_x:=4.0", "_goal_y:=1.0"])
     bag = os.path.join(run_dir, "run.bag")
     recorder = spawn("rosbag", *_recorder(bag, _bag_topics(row)))
