@@ -115,37 +115,37 @@ class Engine:
             topics, nodes = set(), set()
             slots: Set[Tuple[str, Tuple[ast.PathElem, ...]]] = set()
             volatile = bool(node.compiled.ops)
+            is_timed = False
             for e in ast.walk(expr):
-                if isinstance(e, (ast.Age, ast.Frequency, ast.StampAge, ast.NodeStat, ast.Rate, ast.Active)):
-                    volatile = True
-                elif isinstance(e, ast.ArrayFn) and e.ref.path[:1] == ("ranges",):
-                    volatile = True  # reads the scan's range limits too
                 if isinstance(e, ast.TopicRef):
                     slots.add((e.topic, e.path))
+                    topics.add(e.topic)
                 elif isinstance(e, ast.RuleRef):
                     inputs[i].add(self._at[e.key])
-                if isinstance(e, ast.TopicRef):
-                    topics.add(e.topic)
+                    self._nodes[self._at[e.key]].users.add(i)
                 elif isinstance(e, (ast.Age, ast.Frequency, ast.StampAge)):
+                    volatile = is_timed = True  # ticks re-evaluate whatever time changes
                     topics.add(e.topic)
                     if isinstance(e, ast.Frequency):
                         windows[e.topic] = max(windows.get(e.topic, 0.0), e.window)
                     if isinstance(e, ast.StampAge):
                         self._stamped.add(e.topic)
                 elif isinstance(e, ast.NodeStat):
+                    volatile = True
                     nodes.add(e.node)
                 elif isinstance(e, ast.Rate):
+                    volatile = True
                     paths = self._rate_paths.setdefault(e.ref.topic, [])
                     if e.ref.path not in paths:  # one rate per field, however many rules use it
                         paths.append(e.ref.path)
-                elif isinstance(e, ast.ArrayFn) and e.ref.path[:1] == ("ranges",):
-                    self._laser.add(e.ref.topic)
                 elif isinstance(e, ast.Active):
+                    volatile = True
                     readers.setdefault(e.action, []).append(i)
-                elif isinstance(e, ast.RuleRef):
-                    self._nodes[self._at[e.key]].users.add(i)
-            if any(isinstance(e, (ast.Age, ast.StampAge, ast.Frequency)) for e in ast.walk(expr)):
-                timed.append(i)  # ticks re-evaluate whatever time changes, where no crossing is announced too
+                elif isinstance(e, ast.ArrayFn) and e.ref.path[:1] == ("ranges",):
+                    volatile = True  # reads the scan's range limits too
+                    self._laser.add(e.ref.topic)
+            if is_timed:
+                timed.append(i)
             topics_of.append(topics)
             nodes_of.append(nodes)
             node.volatile, node.slots, node.inputs = volatile, frozenset(slots), frozenset(inputs[i])
