@@ -384,16 +384,24 @@ def _found(text: str, loc: int) -> str:
     return f"'{m.group(0)}'" if m else "end of file"
 
 
-def parse_source(source: Source) -> ast.Spec:
-    """Parse one source file into a Spec; raises SpecError for a syntax error."""
+def parse_source(source: Source, fast: bool = True) -> ast.Spec:
+    """Parse one source file into a Spec; raises SpecError for a syntax error.
+
+    The fast parser (fastparse.py) is tried first; a text it does not accept is parsed by this
+    pyparsing grammar, the reference, which reports every syntax error. fast=False: pyparsing only.
+    """
     global _GRAMMAR
+    from . import fastparse  # it imports this module's tables
+
     with _LOCK:
         if _GRAMMAR is None:
             _GRAMMAR = _build().parseWithTabs()
         _ctx.source = source
         try:
             text, comments = _strip_comments(source.text)
-            toks = _GRAMMAR.parseString(text, parseAll=True)
+            toks = fastparse.accept(text, source) if fast else None
+            if toks is None:
+                toks = _GRAMMAR.parseString(text, parseAll=True)
         except _UnterminatedComment as exc:
             raise _error(source, exc.loc, "unterminated comment '/*'") from None
         except pp.ParseBaseException as exc:
