@@ -80,6 +80,7 @@ class MasterWatch:
         self.state = "connected"
         self.reregistrations = 0
         self.down_since: Optional[float] = None  # monotonic time of the first failed poll
+        self._caller = rpc.Caller(master_uri, timeout)  # polled: one kept connection
         self._stop = threading.Event()
         self._thread: Optional[threading.Thread] = None
 
@@ -91,6 +92,7 @@ class MasterWatch:
         self._stop.set()
         if self._thread is not None:
             self._thread.join(2.0)
+        self._caller.close()
 
     def _run(self) -> None:
         while not self._stop.wait(self.period):
@@ -101,9 +103,8 @@ class MasterWatch:
 
     def check(self) -> str:
         """One poll: 'ok', 'unreachable', 'foreign' (another node holds our name) or 're-registered'."""
-        master = rpc.proxy(self.master_uri, self.timeout)
         try:
-            code, msg, uri = master.lookupNode(self.caller_id, self.caller_id)
+            code, msg, uri = self._caller.call("lookupNode", self.caller_id, self.caller_id)
         except (OSError, socket.error, xmlrpc.client.Error) as exc:
             if self.down_since is None:
                 self.down_since = time.monotonic()
@@ -122,7 +123,7 @@ class MasterWatch:
         if code == 1:  # rospy shuts a node down when another takes its name; do not fight over it
             self.state = f"another node ({uri}) holds the name {self.caller_id}"
             return "foreign"
-        reg = register_all(master, self.caller_id, self.node_uri)
+        reg = register_all(rpc.proxy(self.master_uri, self.timeout), self.caller_id, self.node_uri)
         self.reregistrations += 1
         self.state = "connected"
         self.log("warn", f"the master at {self.master_uri} did not know this node (it restarted): registered "

@@ -78,6 +78,8 @@ class NodeSampler:
         self._thread: Optional[threading.Thread] = None
         self._pool = concurrent.futures.ThreadPoolExecutor(max_workers=max(1, min(8, len(nodes))),
                                                            thread_name_prefix="rubass-node")
+        self._callers: Dict[str, rpc.Caller] = {}  # kept connections, by URI
+        self._callers_lock = threading.Lock()
 
     def start(self) -> None:
         if self.status:
@@ -89,6 +91,24 @@ class NodeSampler:
         if self._thread is not None:
             self._thread.join(2.0)
         self._pool.shutdown(wait=False)
+        with self._callers_lock:
+            callers, self._callers = list(self._callers.values()), {}
+        for caller in callers:
+            caller.close()
+
+    def _caller(self, uri: str, timeout: float) -> rpc.Caller:
+        """The kept connection to a URI (the master's, or a node's)."""
+        with self._callers_lock:
+            caller = self._callers.get(uri)
+            if caller is None:
+                caller = self._callers[uri] = rpc.Caller(uri, timeout)
+            return caller
+
+    def _forget_caller(self, uri: str) -> None:
+        with self._callers_lock:
+            caller = self._callers.pop(uri, None)
+        if caller is not None:
+            caller.close()
 
     def _run(self) -> None:
         next_at = time.monotonic()
@@ -121,7 +141,7 @@ class NodeSampler:
         """The pid of the process answering at a node's URI, or None and why not (a hung node
         is found by the timeout: its kernel still accepts the connection)."""
         try:
-            code, msg, pid = rpc.proxy(uri, self.timeout).getPid(self.caller_id)
+            code, msg, pid = self._caller(uri, self.timeout).call("getPid", self.caller_id)
         except socket.timeout:
             return None, f"did not answer getPid within {self.timeout * 1000:.0f} ms (hung?)"
         except (OSError, xmlrpc.client.Error, ValueError) as exc:
@@ -134,10 +154,14 @@ class NodeSampler:
         name = st.resolved
         note = ""
         try:  # the master with a timeout too: a hung master must not stall every sample
-            code, msg, uri = rpc.proxy(self.master_uri, max(self.timeout, 0.5)).lookupNode(self.caller_id, name)
-        except (OSError, socket.error, xmlrpc.client.Error) as exc:
+            code, msg, uri = self._caller(self.master_uri, max(self.timeout, 0.5)).call("lookupNode", self.caller_id,
+                                                                                        name)
+        except (OSError, socket.error, xmlrpc.client.Error, ValueError) as exc:
             code, msg, uri = -2, str(exc), None
         if code == 1:
+            old = self._uris.get(name)
+            if old is not None and old != uri:
+                self._forget_caller(old)  # the node restarted elsewhere: its old address is gone
             self._uris[name] = uri
         else:
             uri = self._uris.get(name)
