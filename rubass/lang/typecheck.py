@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, replace
-from typing import Any, Callable, FrozenSet, List, Optional, Set, Tuple, Union
+from typing import Any, Callable, Dict, FrozenSet, List, Optional, Set, Tuple, Union
 
 from . import ast
 from .builtins import BuiltinChecks
@@ -41,6 +41,9 @@ BARE = Ty("num", DIMENSIONLESS, bare=True)
 def num(d: Optional[Dimension]) -> Ty:
     return Ty("num", d)
 
+
+# expression type -> the name of the ExprChecker method that checks it ('_binary' for Binary)
+_METHOD_NAMES: Dict[type, str] = {}
 
 Resolution = Union[Tuple[str, ast.Expr, Ty], str]  # ('const'|'rule', expr, ty) or an error message
 
@@ -84,8 +87,10 @@ class ExprChecker(BuiltinChecks):
         return out
 
     def check(self, expr: ast.Expr) -> Tuple[ast.Expr, Ty]:
-        method = getattr(self, "_" + type(expr).__name__.lower())
-        return method(expr)
+        name = _METHOD_NAMES.get(type(expr))
+        if name is None:
+            name = _METHOD_NAMES.setdefault(type(expr), "_" + type(expr).__name__.lower())
+        return getattr(self, name)(expr)  # type: ignore[no-any-return]
 
     # -- leaves --------------------------------------------------------------------------
     def _num(self, e: ast.Num) -> Tuple[ast.Expr, Ty]:
@@ -114,6 +119,10 @@ class ExprChecker(BuiltinChecks):
         kind, target, ty = res
         if kind == "rule" and not self.scope.dynamic:
             self.error(e.span, f"a constant cannot use the rule '{e.text}'")
+        if isinstance(target, ast.RuleRef):  # built directly: dataclasses.replace is slow in this hot path
+            return ast.RuleRef(target.key, e.span), ty
+        if isinstance(target, ast.Lit):
+            return ast.Lit(target.value, e.span), ty
         return replace(target, span=e.span), ty
 
     def _topicref(self, e: ast.TopicRef) -> Tuple[ast.Expr, Ty]:
@@ -180,10 +189,10 @@ class ExprChecker(BuiltinChecks):
         operand, ty = self.check(e.operand)
         if e.op == "not":
             self._want_bool(ty, e.operand.span, "'not'")
-            out: ast.Expr = replace(e, operand=operand)
+            out: ast.Expr = ast.Unary(e.op, operand, e.span)
             return _fold(out), BOOL
         self._want_num(ty, e.operand.span, "'-'")
-        return _fold(replace(e, operand=operand)), ty
+        return _fold(ast.Unary(e.op, operand, e.span)), ty
 
     def _chain(self, e: ast.Binary) -> Tuple[ast.Expr, Ty]:
         """A long and/or chain, term by term (a generated spec may have hundreds of terms)."""
@@ -210,7 +219,7 @@ class ExprChecker(BuiltinChecks):
             return self._chain(e)
         left, lt = self.check(e.left)
         right, rt = self.check(e.right)
-        out = replace(e, left=left, right=right)
+        out = ast.Binary(e.op, left, right, e.span)
         op = e.op
         if op in ("and", "or"):
             self._want_bool(lt, e.left.span, f"'{op}'")
@@ -263,7 +272,7 @@ class ExprChecker(BuiltinChecks):
         elif math.isinf(duration.value):
             self.error(e.duration.span, f"the duration of '{word}' must be finite"
                                         + (" (a 'for' of infinity would never be true)" if word == "for" else ""))
-        return replace(e, operand=operand, duration=duration), BOOL
+        return type(e)(operand, duration, e.span), BOOL  # For or Within
 
     # -- functions -----------------------------------------------------------------------
     def _call(self, e: ast.Call) -> Tuple[ast.Expr, Ty]:
@@ -293,7 +302,7 @@ class ExprChecker(BuiltinChecks):
         if e.func == "sqrt" and result.dim is not None:
             d = dim_sqrt(result.dim)
             result = Ty("num", d if d is not None else ODD, result.bare)
-        return _fold(replace(e, args=tuple(args))), result
+        return _fold(ast.Call(e.func, tuple(args), e.span)), result
 
     # -- helpers -------------------------------------------------------------------------
     def _want_bool(self, ty: Ty, span: Span, what: str) -> None:
