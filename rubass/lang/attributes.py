@@ -53,9 +53,13 @@ class AttrChecker:
         self._entity_attrs = {name: self.own(ent.attrs, "entity") for name, ent in entities.items()}
         self._rule_attrs = {(name, r.name.name): self.own(r.attrs, "rule")
                             for name, ent in entities.items() for r in ent.rules}
+        self._inherited = {name: {k: v for k, v in attrs.items() if k not in NOT_INHERITED}
+                           for name, attrs in self._entity_attrs.items()}
 
     def rule_attrs(self, entity: ast.Entity, rule: ast.Rule) -> Attrs:
         """A rule's attributes: its own, and for each attribute it lacks, its entity's (not the id)."""
-        inherited = {k: v for k, v in self._entity_attrs.get(entity.name.name, {}).items() if k not in NOT_INHERITED}
-        inherited.update(self._rule_attrs.get((entity.name.name, rule.name.name), {}))
+        inherited = dict(self._inherited.get(entity.name.name, ()))  # a dict of its own for each rule
+        own = self._rule_attrs.get((entity.name.name, rule.name.name))
+        if own:
+            inherited.update(own)
         return inherited

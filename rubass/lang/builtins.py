@@ -2,15 +2,30 @@
 (Age, Frequency, Rate, ArrayFn, Quant, Latch, Active, Zone …) that the engine runs directly."""
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import replace
-from typing import Any, List, Tuple
+from typing import Any, FrozenSet, List, Tuple
 
 from . import ast
 from .geometry import polygon_problem
 from .units import COUNT, DIMENSIONLESS, FREQUENCY, LENGTH, MEMORY, TIME, dim_mul
 
 # Ty, BOOL, … live in typecheck; imported lazily there to avoid a cycle.
+
+
+_TOPIC_FORMS = {"frequency": "frequency(topic /t) or frequency(topic /t, 2 s)", "age": "age(topic /t)",
+                "stamp_age": "stamp_age(topic /t)"}
+
+
+def _norm_node(name: str) -> str:
+    return name if name.startswith("/") else "/" + name
+
+
+@functools.lru_cache(maxsize=256)
+def _norm_nodes(nodes: Tuple[str, ...]) -> FrozenSet[str]:
+    """An entity's nodes, each with its leading '/' (once per entity, not once per node() call)."""
+    return frozenset(_norm_node(n) for n in nodes)
 
 
 class BuiltinChecks:
@@ -53,10 +68,8 @@ class BuiltinChecks:
         args = list(e.args)
         self._dynamic_only(e)
         max_args = 2 if e.func == "frequency" else 1
-        forms = {"frequency": "frequency(topic /t) or frequency(topic /t, 2 s)", "age": "age(topic /t)",
-                 "stamp_age": "stamp_age(topic /t)"}
         if not args or len(args) > max_args or not isinstance(args[0], ast.TopicRef):
-            self.error(e.span, f"{e.func}() is written {forms[e.func]}")  # type: ignore[attr-defined]
+            self.error(e.span, f"{e.func}() is written {_TOPIC_FORMS[e.func]}")  # type: ignore[attr-defined]
             return e, ANY
         ref = args[0]
         if ref.path:
@@ -90,8 +103,7 @@ class BuiltinChecks:
             return e, ANY
         ref = e.args[0]
         nodes = self.scope.nodes
-        norm = lambda n: n if n.startswith("/") else "/" + n  # noqa: E731
-        if nodes is not None and norm(ref.node) not in {norm(n) for n in nodes}:
+        if nodes is not None and _norm_node(ref.node) not in _norm_nodes(nodes):
             from .errors import did_you_mean
             self.error(ref.span, f"node '{ref.node}' is not in the nodes of entity '{self.scope.entity}' "  # type: ignore[attr-defined]
                                  f"({', '.join(nodes) or 'none declared'}){did_you_mean(ref.node, nodes)}")

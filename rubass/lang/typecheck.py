@@ -38,8 +38,15 @@ STR = Ty("str")
 BARE = Ty("num", DIMENSIONLESS, bare=True)
 
 
+_NUM_TYS: Dict[Optional[Dimension], Ty] = {}
+
+
 def num(d: Optional[Dimension]) -> Ty:
-    return Ty("num", d)
+    """The type of a number of dimension d (one shared Ty per dimension: Ty is immutable)."""
+    ty = _NUM_TYS.get(d)
+    if ty is None:
+        ty = _NUM_TYS.setdefault(d, Ty("num", d))
+    return ty
 
 
 # expression type -> the name of the ExprChecker method that checks it ('_binary' for Binary)
