@@ -1,13 +1,17 @@
-"""Reading ROS 1 recordings for replay: messages in time order, deserialised only where needed."""
+"""Reading ROS 1 recordings for replay: messages in time order, deserialised only where needed.
+
+Indexed bags of format 2.0 are read by our own reader (bagfile.py, about three times as fast as
+rosbag's, and it opens a bag without reading its per-message index); other bags (format 1.2,
+encrypted, an unknown compression) by rosbag.
+"""
 from __future__ import annotations
 
 import os
 from dataclasses import dataclass
-from typing import Any, Dict, Iterator, List, Optional, Set, Tuple
-
-import rosbag
+from typing import Any, Dict, Iterator, List, Optional, Set, Tuple, Union
 
 from ..lang.errors import RubassError
+from .bagfile import BagFile, BagFormatError, Unindexed, Unsupported
 
 
 class BagError(RubassError):
@@ -23,12 +27,36 @@ class BagInfo:
     types: Dict[str, str]  # topic -> message type
 
 
-def open_bag(path: str) -> Tuple["rosbag.Bag", BagInfo]:
+Bag = Union[BagFile, Any]  # our reader, or a rosbag.Bag where ours does not apply
+
+
+def _unindexed(path: str) -> BagError:
+    return BagError(f"{path}: the bag is not indexed (was recording interrupted?): run 'rosbag reindex {path}'")
+
+
+def open_bag(path: str) -> Tuple[Bag, BagInfo]:
     """Open a bag for reading; BagError for a missing, unreadable, unindexed or corrupt file."""
     if not os.path.exists(path):
         raise BagError(f"{path}: no such file")
     if os.path.isdir(path):
         raise BagError(f"{path}: is a directory, not a bag")
+    try:
+        bag = BagFile(path)
+    except Unsupported:
+        return _open_rosbag(path)
+    except Unindexed:
+        raise _unindexed(path) from None
+    except BagFormatError as exc:
+        raise BagError(f"{path}: not a readable ROS 1 bag ({exc})") from None
+    except OSError as exc:
+        raise BagError(f"{path}: not a readable ROS 1 bag ({exc.__class__.__name__}: {exc})") from None
+    topics = bag.topics()
+    return bag, BagInfo(path, bag.start_time, bag.end_time, bag.message_count, {t: v[0] for t, v in topics.items()})
+
+
+def _open_rosbag(path: str) -> Tuple[Any, BagInfo]:
+    import rosbag
+
     try:
         bag = rosbag.Bag(path, "r")
         info = bag.get_type_and_topic_info()
@@ -37,27 +65,48 @@ def open_bag(path: str) -> Tuple["rosbag.Bag", BagInfo]:
         start = bag.get_start_time() if count else 0.0
         end = bag.get_end_time() if count else 0.0
     except rosbag.ROSBagUnindexedException:
-        raise BagError(f"{path}: the bag is not indexed (was recording interrupted?): "
-                       f"run 'rosbag reindex {path}'") from None
+        raise _unindexed(path) from None
     except (rosbag.ROSBagException, OSError, ValueError, KeyError, EOFError) as exc:
         raise BagError(f"{path}: not a readable ROS 1 bag ({exc.__class__.__name__}: {exc})") from None
     return bag, BagInfo(path, start, end, count, types)
 
 
-def message_classes(bag: "rosbag.Bag", topics: List[str]) -> Dict[str, Any]:
-    """The message class of each topic (from the first message, so unknown types work too)."""
+def message_classes(bag: Bag, topics: List[str]) -> Dict[str, Any]:
+    """The message class of each topic (that of its first message, so unknown types work too)."""
     out: Dict[str, Any] = {}
     for topic in topics:
+        if isinstance(bag, BagFile):
+            try:
+                cls = bag.topic_class(topic)
+            except BagFormatError as exc:
+                raise BagError(f"{bag.filename}: the bag is corrupt: {exc}") from None
+            if cls is not None:
+                out[topic] = cls
+            continue
         for _, raw, _ in bag.read_messages(topics=[topic], raw=True):
             out[topic] = raw[-1]
             break
     return out
 
 
-def read(bag: "rosbag.Bag", topics: List[str], decode: Set[str]) -> Iterator[Tuple[float, str, Optional[Any]]]:
+def read(bag: Bag, topics: List[str], decode: Set[str]) -> Iterator[Tuple[float, str, Optional[Any]]]:
     """(time, topic, message or None) in recorded order; only topics in `decode` are deserialised."""
     if not topics:
         return  # rosbag reads every topic when given none
+    if isinstance(bag, BagFile):
+        try:
+            yield from bag.read(topics, decode)
+        except BagFormatError as exc:
+            raise BagError(f"{bag.filename}: the bag is corrupt: {exc}") from None
+        except OSError as exc:
+            raise BagError(f"{bag.filename}: the bag cannot be read ({exc.__class__.__name__}: {exc})") from None
+        return
+    yield from _read_rosbag(bag, topics, decode)
+
+
+def _read_rosbag(bag: Any, topics: List[str], decode: Set[str]) -> Iterator[Tuple[float, str, Optional[Any]]]:
+    import rosbag
+
     try:
         for topic, raw, stamp in bag.read_messages(topics=topics, raw=True):
             msg = None

@@ -1,0 +1,436 @@
+"""A fast reader of indexed ROS 1 bag v2.0 files for replay, in the order rosbag's read_messages gives.
+
+It reads the file header, the connection and chunk-info records at the end (never the per-message
+index), then walks the chunks by start time, parsing each message record with one struct call and
+deserialising only the topics asked for. Order: by time, then by the connection's place in the
+index (as rosbag's heapq.merge breaks ties), then by place in the file. rosbag gives the same order
+whenever each connection's messages were written in time order (always so for `rosbag record`).
+Bags this reader does not handle (format 1.2, encryption, an unknown compression) raise
+Unsupported, so that the caller can use rosbag instead.
+"""
+from __future__ import annotations
+
+import bz2
+import os
+import struct
+from bisect import bisect_left
+from dataclasses import dataclass, field
+from typing import Any, Callable, Dict, Iterable, Iterator, List, Optional, Set, Tuple
+
+VERSION_LINE = b"#ROSBAG V2.0\n"
+OP_MSG_DATA, OP_FILE_HEADER, OP_INDEX_DATA, OP_CHUNK, OP_CHUNK_INFO, OP_CONNECTION = 2, 3, 4, 5, 6, 7
+NS = 1000000000
+
+_U32 = struct.Struct("<I")
+_TIME = struct.Struct("<II")
+# A message data record whose header holds exactly the fields op, conn and time is parsed with one
+# struct call; writers order the fields differently (rosbag's Python writer: op, conn, time), so a
+# layout is made for each order met: (struct, index of the op field, of conn's name, of time's name).
+_FIELD_OP = b"\x04\x00\x00\x00op=\x02"
+_FIELD_CONN = b"\x09\x00\x00\x00conn="
+_FIELD_TIME = b"\x0d\x00\x00\x00time="
+_PIECES = {"op": ("8s", 1), "conn": ("9sI", 2), "time": ("9sII", 3)}
+Layout = Tuple[struct.Struct, int, int, int]
+_layouts: Dict[Tuple[str, ...], Layout] = {}
+
+
+def _layout(order: Tuple[str, ...]) -> Layout:
+    """The layout of message records whose header fields come in this order."""
+    if order not in _layouts:
+        fmt, at, index = "<I", {}, 1
+        for name in order:
+            fmt += _PIECES[name][0]
+            at[name] = index
+            index += _PIECES[name][1]
+        _layouts[order] = (struct.Struct(fmt + "I"), at["op"], at["conn"], at["time"])
+    return _layouts[order]
+
+
+_MSG_HEADER_LEN = 38
+_MSG_PREFIX = 46  # header length, header, data length
+_MSG_FIELDS = {"op", "conn", "time"}
+
+
+class BagFormatError(Exception):
+    """The file is not a readable bag: the message says what is wrong, in a few words."""
+
+
+class Unindexed(BagFormatError):
+    """The bag has no index (recording interrupted, or the file truncated)."""
+
+
+class Unsupported(Exception):
+    """A bag this reader does not handle (another format version, encryption, a compression)."""
+
+
+@dataclass(frozen=True)
+class Connection:
+    """A connection record: the attributes rosbag's _ConnectionInfo has."""
+    id: int
+    topic: str
+    datatype: str
+    md5sum: str
+    msg_def: str
+    header: Dict[str, bytes] = field(repr=False, compare=False)
+
+
+@dataclass
+class Chunk:
+    """A chunk-info record and its chunk's header: times in nanoseconds."""
+    index: int  # place in the file
+    pos: int
+    start: int
+    end: int
+    counts: Dict[int, int]  # connection id -> messages
+    compression: str = "none"
+    data_pos: int = 0
+    data_len: int = 0
+
+
+def _fields(buf: bytes, pos: int, end: int) -> Dict[str, bytes]:
+    """A record header's name=value fields."""
+    out: Dict[str, bytes] = {}
+    while pos < end:
+        if pos + 4 > end:
+            raise BagFormatError("a record header is cut short")
+        (size,) = _U32.unpack_from(buf, pos)
+        pos += 4
+        if pos + size > end:
+            raise BagFormatError("a record header field runs past its header")
+        name, sep, value = buf[pos:pos + size].partition(b"=")
+        if not sep:
+            raise BagFormatError("a record header field has no '='")
+        out[name.decode("latin-1")] = value
+        pos += size
+    return out
+
+
+def _record(buf: bytes, pos: int) -> Tuple[Dict[str, bytes], int, int]:
+    """(header fields, data start, data end) of the record at pos in buf."""
+    if pos + 4 > len(buf):
+        raise BagFormatError("a record is cut short")
+    (hlen,) = _U32.unpack_from(buf, pos)
+    hend = pos + 4 + hlen
+    if hend + 4 > len(buf):
+        raise BagFormatError("a record header runs past the end of the data")
+    fields = _fields(buf, pos + 4, hend)
+    (dlen,) = _U32.unpack_from(buf, hend)
+    if hend + 4 + dlen > len(buf):
+        raise BagFormatError("a record runs past the end of the data")
+    return fields, hend + 4, hend + 4 + dlen
+
+
+def _int(fields: Dict[str, bytes], name: str, fmt: str) -> int:
+    try:
+        return struct.unpack("<" + fmt, fields[name])[0]
+    except KeyError:
+        raise BagFormatError(f"a record has no field '{name}'") from None
+    except struct.error:
+        raise BagFormatError(f"a record's field '{name}' has the wrong size") from None
+
+
+def _op(fields: Dict[str, bytes]) -> int:
+    return _int(fields, "op", "B")
+
+
+def _time(fields: Dict[str, bytes], name: str) -> int:
+    try:
+        secs, nsecs = _TIME.unpack(fields[name])
+    except KeyError:
+        raise BagFormatError(f"a record has no field '{name}'") from None
+    except struct.error:
+        raise BagFormatError(f"a record's field '{name}' has the wrong size") from None
+    return secs * NS + nsecs
+
+
+def _str(fields: Dict[str, bytes], name: str) -> str:
+    try:
+        return fields[name].decode("utf-8")
+    except KeyError:
+        raise BagFormatError(f"a connection has no field '{name}'") from None
+    except UnicodeDecodeError:
+        raise BagFormatError(f"a connection's field '{name}' is not text") from None
+
+
+def _seconds(ns: int) -> float:
+    """Nanoseconds as seconds, rounded as genpy's Time.to_sec rounds them."""
+    secs, nsecs = divmod(ns, NS)
+    return secs + nsecs / 1e9
+
+
+def _decompressor(name: str) -> Callable[[bytes], bytes]:
+    if name == "none":
+        return lambda data: data
+    if name == "bz2":
+        return bz2.decompress
+    if name == "lz4":
+        try:
+            import roslz4  # what rosbag itself uses (Debian python3-roslz4, a dependency of python3-rosbag)
+        except ImportError:
+            raise Unsupported("lz4 chunks need the roslz4 module") from None
+        return roslz4.decompress  # type: ignore[no-any-return]
+    raise Unsupported(f"chunks compressed with '{name}'")
+
+
+def message_class(conn: Connection) -> Any:
+    """The message class of a connection, as rosbag makes it (from the recorded definition)."""
+    try:
+        from rosbag.bag import _get_message_type  # rosbag's cache: the very classes rosbag yields
+    except ImportError:  # pragma: no cover - rosbag is installed with this reader's users
+        import genpy.dynamic
+
+        return genpy.dynamic.generate_dynamic(conn.datatype, conn.msg_def)[conn.datatype]
+    return _get_message_type(conn)
+
+
+class BagFile:
+    """An indexed bag v2.0 open for reading; BagFormatError, Unindexed or Unsupported if it cannot be."""
+
+    def __init__(self, path: str) -> None:
+        self.filename = path
+        self._file = open(path, "rb")
+        try:
+            self._open()
+        except BaseException:
+            self._file.close()
+            raise
+
+    # -- opening -------------------------------------------------------------------------
+    def _open(self) -> None:
+        f = self._file
+        size = os.fstat(f.fileno()).st_size
+        line = f.read(len(VERSION_LINE))
+        if line != VERSION_LINE:
+            if line.startswith(b"#ROSBAG V"):
+                raise Unsupported(f"bag format {line[9:].strip().decode('latin-1')}")
+            raise BagFormatError("no ROS bag version line at its start")
+        head = f.read(8192)
+        fields, _, _ = _record(head, 0)
+        if _op(fields) != OP_FILE_HEADER:
+            raise BagFormatError("no file header record after the version line")
+        if "encryptor" in fields and fields["encryptor"]:
+            raise Unsupported("an encrypted bag")
+        index_pos = _int(fields, "index_pos", "Q")
+        conn_count = _int(fields, "conn_count", "I")
+        chunk_count = _int(fields, "chunk_count", "I")
+        if index_pos == 0:
+            raise Unindexed("the bag is not indexed")
+        if index_pos > size:
+            raise Unindexed(f"its index is at byte {index_pos}, past its end ({size} bytes): it is truncated")
+        f.seek(index_pos)
+        buf = f.read()
+        pos = 0
+        connections: Dict[int, Connection] = {}
+        for _ in range(conn_count):
+            fields, start, end = _record(buf, pos)
+            if _op(fields) != OP_CONNECTION:
+                raise BagFormatError("a connection record is missing from the index")
+            conn_id = _int(fields, "conn", "I")
+            info = _fields(buf, start, end)
+            connections[conn_id] = Connection(conn_id, _str(fields, "topic"), _str(info, "type"),
+                                              _str(info, "md5sum"), _str(info, "message_definition"), info)
+            pos = end
+        chunks: List[Chunk] = []
+        for i in range(chunk_count):
+            fields, start, end = _record(buf, pos)
+            if _op(fields) != OP_CHUNK_INFO or _int(fields, "ver", "I") != 1:
+                raise BagFormatError("a chunk info record is missing from the index")
+            counts = {}
+            for j in range(_int(fields, "count", "I")):
+                if start + 8 * j + 8 > end:
+                    raise BagFormatError("a chunk info record is cut short")
+                conn_id, n = _TIME.unpack_from(buf, start + 8 * j)
+                counts[conn_id] = n
+            chunks.append(Chunk(i, _int(fields, "chunk_pos", "Q"), _time(fields, "start_time"),
+                                _time(fields, "end_time"), counts))
+            pos = end
+        for chunk in chunks:
+            self._chunk_header(chunk, size)
+        totals: Dict[int, int] = {}
+        for chunk in chunks:
+            for conn_id, n in chunk.counts.items():
+                if conn_id not in connections:
+                    raise BagFormatError(f"a chunk holds messages of connection {conn_id}, which has no record")
+                totals[conn_id] = totals.get(conn_id, 0) + n
+        # as rosbag: connections without messages are left out
+        self._connections = {c: conn for c, conn in connections.items() if totals.get(c)}
+        self.connections = self._connections
+        self.chunks = chunks
+        self._counts = totals
+
+    def _chunk_header(self, chunk: Chunk, size: int) -> None:
+        if chunk.pos >= size:
+            raise BagFormatError(f"a chunk at byte {chunk.pos} lies past the end of the file")
+        self._file.seek(chunk.pos)
+        head = self._file.read(4)
+        if len(head) < 4:
+            raise BagFormatError(f"the chunk at byte {chunk.pos} is cut short")
+        head += self._file.read(_U32.unpack(head)[0] + 4)
+        fields, data_pos = self._header_only(head, chunk)
+        if _op(fields) != OP_CHUNK:
+            raise BagFormatError(f"no chunk at byte {chunk.pos}, where the index says one is")
+        chunk.compression = fields.get("compression", b"none").decode("latin-1")
+        chunk.data_pos = chunk.pos + data_pos
+        chunk.data_len = _U32.unpack_from(head, data_pos - 4)[0]
+        if chunk.data_pos + chunk.data_len > size:
+            raise BagFormatError(f"the chunk at byte {chunk.pos} runs past the end of the file (truncated?)")
+        _decompressor(chunk.compression)
+
+    @staticmethod
+    def _header_only(head: bytes, chunk: Chunk) -> Tuple[Dict[str, bytes], int]:
+        """A chunk record's header fields and where its data starts (relative to the record)."""
+        hend = 4 + _U32.unpack_from(head, 0)[0]
+        if hend + 4 > len(head):
+            raise BagFormatError(f"the chunk at byte {chunk.pos} is cut short")
+        return _fields(head, 4, hend), hend + 4
+
+    # -- what it holds -------------------------------------------------------------------
+    @property
+    def message_count(self) -> int:
+        return sum(self._counts.values())
+
+    @property
+    def start_time(self) -> float:
+        """As rosbag's get_start_time: the first chunk's start (0.0 for an empty bag)."""
+        return _seconds(self.chunks[0].start) if self.chunks and self._counts else 0.0
+
+    @property
+    def end_time(self) -> float:
+        """As rosbag's get_end_time: the last chunk's end (0.0 for an empty bag)."""
+        return _seconds(self.chunks[-1].end) if self.chunks and self._counts else 0.0
+
+    def topics(self) -> Dict[str, Tuple[str, int]]:
+        """topic -> (type of its first connection, messages), as rosbag's get_type_and_topic_info."""
+        out: Dict[str, Tuple[str, int]] = {}
+        for conn in self._connections.values():
+            datatype, n = out.get(conn.topic, (conn.datatype, 0))
+            out[conn.topic] = (datatype, n + self._counts[conn.id])
+        return out
+
+    def topic_class(self, topic: str) -> Any:
+        """The message class of a topic's first message (None if it has none)."""
+        conns = [c for c in self._connections.values() if c.topic == topic]
+        if len(conns) == 1:
+            return self._class(conns[0])
+        for _, _, msg in self.read([topic], {topic}):  # several connections: the first message's
+            return type(msg)
+        return None
+
+    # -- reading -------------------------------------------------------------------------
+    def read(self, topics: Iterable[str], decode: Set[str] = frozenset()  # type: ignore[assignment]
+             ) -> Iterator[Tuple[float, str, Optional[Any]]]:
+        """(time in s, topic, message or None) in rosbag's order; only topics in decode are deserialised."""
+        wanted = set(topics)
+        ranks = {c: r for r, c in enumerate(self._connections)}
+        nconn = max(len(ranks), 1)
+        conns: Dict[int, Tuple[int, str, Any]] = {}
+        for conn in self._connections.values():
+            if conn.topic in wanted:
+                cls = self._class(conn) if conn.topic in decode else None
+                conns[conn.id] = (ranks[conn.id], conn.topic, cls)
+        chunks = sorted((c for c in self.chunks if any(k in conns for k in c.counts)), key=lambda c: (c.start, c.index))
+        held: List[Tuple[float, str, Any]] = []
+        held_keys: List[int] = []
+        for i, chunk in enumerate(chunks):
+            items, keys, in_order = self._scan(chunk, conns, nconn)
+            if held:
+                in_order = in_order and (not keys or held_keys[-1] <= keys[0])
+                items, keys = held + items, held_keys + keys
+            if not in_order:  # a stable sort keeps equal stamps of one connection in file order
+                order = sorted(range(len(keys)), key=keys.__getitem__)
+                items, keys = [items[j] for j in order], [keys[j] for j in order]
+            cut = bisect_left(keys, chunks[i + 1].start * nconn) if i + 1 < len(chunks) else len(keys)
+            held, held_keys = items[cut:], keys[cut:]
+            if cut == len(items):
+                yield from items
+            else:
+                yield from items[:cut]
+        yield from held
+
+    def _class(self, conn: Connection) -> Any:
+        try:
+            return message_class(conn)
+        except Exception as exc:  # genmsg errors on a broken recorded definition
+            raise BagFormatError(f"topic {conn.topic}: no message class for {conn.datatype} "
+                                 f"({exc.__class__.__name__}: {exc})") from None
+
+    def _chunk_data(self, chunk: Chunk) -> bytes:
+        self._file.seek(chunk.data_pos)
+        data = self._file.read(chunk.data_len)
+        if len(data) != chunk.data_len:
+            raise BagFormatError(f"the chunk at byte {chunk.pos} is cut short")
+        try:
+            return _decompressor(chunk.compression)(data)
+        except (OSError, ValueError, EOFError, RuntimeError) as exc:  # bz2: OSError; roslz4: RuntimeError
+            raise BagFormatError(f"the chunk at byte {chunk.pos} cannot be decompressed "
+                                 f"({exc.__class__.__name__}: {exc})") from None
+
+    def _scan(self, chunk: Chunk, conns: Dict[int, Tuple[int, str, Any]], nconn: int
+              ) -> Tuple[List[Tuple[float, str, Any]], List[int], bool]:
+        """A chunk's wanted messages in file order, their order keys, and whether the keys ascend."""
+        buf = self._chunk_data(chunk)
+        n = len(buf)
+        items: List[Tuple[float, str, Any]] = []
+        keys: List[int] = []
+        add, add_key = items.append, keys.append
+        layout, i_op, i_conn, i_time = _layout(("op", "conn", "time"))
+        unpack = layout.unpack_from
+        in_order, last, pos = True, -1, 0
+        get = conns.get
+        try:
+            while pos < n:
+                try:
+                    r = unpack(buf, pos)
+                except struct.error:
+                    r = (0,)
+                if (r[0] == _MSG_HEADER_LEN and r[i_op] == _FIELD_OP and r[i_conn] == _FIELD_CONN
+                        and r[i_time] == _FIELD_TIME):
+                    conn, secs, nsecs = r[i_conn + 1], r[i_time + 1], r[i_time + 2]
+                    start = pos + _MSG_PREFIX
+                    pos = start + r[-1]
+                else:  # a connection record, or a message laid out otherwise
+                    record = pos
+                    fields, start, pos = _record(buf, pos)
+                    op = _op(fields)
+                    if op == OP_CONNECTION:
+                        continue
+                    if op != OP_MSG_DATA:
+                        raise BagFormatError(f"a record with op {op} inside a chunk")
+                    conn, stamp = _int(fields, "conn", "I"), _time(fields, "time")
+                    secs, nsecs = divmod(stamp, NS)
+                    if start - record == _MSG_PREFIX and set(fields) == _MSG_FIELDS:  # the next ones likely too
+                        layout, i_op, i_conn, i_time = _layout(tuple(fields))
+                        unpack = layout.unpack_from
+                if pos > n:
+                    raise BagFormatError("a message runs past the end of its chunk")
+                want = get(conn)
+                if want is None:
+                    continue
+                rank, topic, cls = want
+                key = (secs * NS + nsecs) * nconn + rank
+                if key < last:
+                    in_order = False
+                last = key
+                if cls is None:
+                    add((secs + nsecs / 1e9, topic, None))
+                else:
+                    msg = cls()
+                    msg.deserialize(buf[start:pos])
+                    add((secs + nsecs / 1e9, topic, msg))
+                add_key(key)
+        except BagFormatError as exc:
+            raise BagFormatError(f"the chunk at byte {chunk.pos}: {exc}") from None
+        except Exception as exc:  # genpy.DeserializationError, struct.error from a damaged message
+            raise BagFormatError(f"a message in the chunk at byte {chunk.pos} cannot be read "
+                                 f"({exc.__class__.__name__}: {exc})") from None
+        return items, keys, in_order
+
+    # -- lifecycle -----------------------------------------------------------------------
+    def close(self) -> None:
+        self._file.close()
+
+    def __enter__(self) -> "BagFile":
+        return self
+
+    def __exit__(self, *exc: Any) -> None:
+        self.close()
