@@ -36,6 +36,86 @@ def test_a_local_node_is_measured_from_the_second_sample(tmp_path):
     assert isinstance(got[1][3], float) and got[1][4] > 1e6
 
 
+class _FakeCaller:
+    """Stands for rpc.Caller: answers from a table, counts the calls."""
+
+    def __init__(self, answers, calls, uri):
+        self.answers, self.calls, self.uri = answers, calls, uri
+
+    def call(self, method, *params):
+        self.calls.append((self.uri, method))
+        answer = self.answers[(self.uri, method)]
+        if isinstance(answer, Exception):
+            raise answer
+        return answer
+
+    def close(self):
+        pass
+
+
+def _fake_sampler(answers, calls):
+    sampler = NodeSampler([("driver", "/driver")], lambda *a: None, lambda: 1.0, 0.1, "/rubass")
+    sampler.master_uri = "http://master:11311/"
+    sampler._caller = lambda uri, timeout: _FakeCaller(answers, calls, uri)
+    sampler._is_local = lambda host: False
+    return sampler
+
+
+def test_a_node_is_asked_at_its_uri_and_the_master_where_it_is_at_most_once_a_second(monkeypatch):
+    import time
+
+    calls, clock = [], [100.0]
+    monkeypatch.setattr(time, "monotonic", lambda: clock[0])
+    answers = {("http://master:11311/", "lookupNode"): [1, "", "http://pc:4000/"],
+               ("http://pc:4000/", "getPid"): [1, "", 77]}
+    sampler = _fake_sampler(answers, calls)
+    st = NodeStatus("driver", "/driver")
+    for _ in range(10):  # a second of samples at 10 Hz
+        sampler.sample(st)
+        assert st.alive is True and st.pid == 77
+        clock[0] += 0.099
+    assert calls.count(("http://master:11311/", "lookupNode")) == 1
+    assert calls.count(("http://pc:4000/", "getPid")) == 10
+    clock[0] += 0.02
+    sampler.sample(st)  # over a second since the master was asked: asked again
+    assert calls.count(("http://master:11311/", "lookupNode")) == 2
+
+
+def test_a_node_that_stops_answering_at_its_uri_is_looked_up_again_in_the_same_sample(monkeypatch):
+    calls = []
+    answers = {("http://master:11311/", "lookupNode"): [1, "", "http://pc:4000/"],
+               ("http://pc:4000/", "getPid"): [1, "", 77]}
+    sampler = _fake_sampler(answers, calls)
+    st = NodeStatus("driver", "/driver")
+    sampler.sample(st)
+    # the node restarted elsewhere: the old URI refuses, the master knows the new one
+    answers[("http://pc:4000/", "getPid")] = ConnectionRefusedError("refused")
+    answers[("http://master:11311/", "lookupNode")] = [1, "", "http://pc:4100/"]
+    answers[("http://pc:4100/", "getPid")] = [1, "", 88]
+    calls.clear()
+    sampler.sample(st)
+    assert st.alive is True and st.pid == 88
+    assert calls == [("http://pc:4000/", "getPid"), ("http://master:11311/", "lookupNode"),
+                     ("http://pc:4100/", "getPid")]
+    # killed for good: the master still names the dead URI (it never forgets), nobody answers
+    answers[("http://pc:4100/", "getPid")] = ConnectionRefusedError("refused")
+    sampler.sample(st)
+    assert st.alive is False and "does not answer" in st.why
+
+
+def test_another_process_answering_at_the_uri_is_checked_with_the_master(monkeypatch):
+    calls = []
+    answers = {("http://master:11311/", "lookupNode"): [1, "", "http://pc:4000/"],
+               ("http://pc:4000/", "getPid"): [1, "", 77]}
+    sampler = _fake_sampler(answers, calls)
+    st = NodeStatus("driver", "/driver")
+    sampler.sample(st)
+    answers[("http://pc:4000/", "getPid")] = [1, "", 99]  # the port reused by another process
+    answers[("http://master:11311/", "lookupNode")] = [-1, "unknown node", ""]  # the node is gone
+    sampler.sample(st)
+    assert st.alive is False and "another process (pid 99)" in st.why
+
+
 def test_cpu_of_a_busy_process_is_not_quantized_to_ten_percent_steps():
     import subprocess
     import sys
