@@ -1,7 +1,9 @@
 #!/usr/bin/python3
 """Parse + check time of a generated spec with N rules (default 1,000); prints JSON.
 
-Target: under 1 s on a 2-core machine, so that a live reload is instant.
+Target (issue 17): under 0.3 s (the median of --repeat runs) on a 2-core machine, so that a
+live reload is instant. The spec is first parsed by the fast parser; pyparsing only reports
+errors (docs/language.md).
 Usage: bench/parse_check.py [--rules N] [--repeat K]
 """
 import argparse
@@ -19,6 +21,7 @@ from rubass.lang import load_spec  # noqa: E402
 from rubass.lang.grammar import parse_source  # noqa: E402
 from rubass.lang.source import Source  # noqa: E402
 
+TARGET_S = 0.3
 LIB = """actions:
   stop: {plugin: publish, topic: /cmd_vel, type: geometry_msgs/Twist, rate: 20 Hz, latch: true}
   warn: {plugin: log, level: warn}
@@ -77,8 +80,8 @@ def main() -> None:
         "parse_s_median": round(statistics.median(parse_times), 4),
         "parse_and_check_s_median": round(statistics.median(total_times), 4),
         "parse_and_check_s_max": round(max(total_times), 4),
-        "target_s": 1.0,
-        "met": max(total_times) < 1.0,
+        "target_s": TARGET_S,
+        "met": statistics.median(total_times) < TARGET_S,
         "python": platform.python_version(),
         "cpus": os.cpu_count(),
     }))
