@@ -2,9 +2,11 @@
 from __future__ import annotations
 
 import argparse
+import gc
 import json
 import sys
-from typing import Any, Iterable, Set, Tuple
+from contextlib import contextmanager
+from typing import Any, Iterable, Iterator, Set, Tuple
 
 from ..lang import SpecError, load_spec
 from . import report
@@ -47,6 +49,18 @@ def _sampled_nodes(samples: Iterable[Tuple[float, str, Any]]) -> Set[str]:
         except (ValueError, KeyError, TypeError, AttributeError):
             continue
     return out
+
+
+@contextmanager
+def _fewer_collections() -> Iterator[None]:
+    """Python's cyclic garbage collector run less often: a replay allocates millions of
+    short-lived objects (messages, tuples) and makes few cycles; this saves ~10 % of its time."""
+    before = gc.get_threshold()
+    gc.set_threshold(50000, *before[1:])
+    try:
+        yield
+    finally:
+        gc.set_threshold(*before)
 
 
 def run(args: argparse.Namespace) -> int:
@@ -105,9 +119,10 @@ def run(args: argparse.Namespace) -> int:
 
         node_topics = node_topics if spec.nodes else []
         agent_topics = agent_topics if spec.nodes else []
-        stream = ((t, topic_map.get(topic, topic), msg)
-                  for t, topic, msg in read(bag, present + node_topics + agent_topics,
-                                            decode | set(node_topics) | set(agent_topics)))
+        stream: Iterable[Tuple[float, str, Any]] = read(bag, present + node_topics + agent_topics,
+                                                        decode | set(node_topics) | set(agent_topics))
+        if any(name != spec_name for name, spec_name in topic_map.items()):  # relative names in the spec
+            stream = ((t, topic_map.get(topic, topic), msg) for t, topic, msg in stream)
         if agent_topics:  # multi-host: the agents' reports, for the nodes the monitor's samples do not cover
             from .agents import SAMPLES, agent_samples
 
@@ -119,7 +134,8 @@ def run(args: argparse.Namespace) -> int:
             stream = agent_samples(stream, set(agent_topics), {_global(n): n for n in spec.nodes}, skip, info.end)
             node_topics = node_topics + [SAMPLES]
         try:
-            _, events = replay(spec, stream, info.start, info.end, args.rate, node_topics)
+            with _fewer_collections():
+                _, events = replay(spec, stream, info.start, info.end, args.rate, node_topics)
         except BagError as exc:
             print(f"rubass replay: error: {exc}", file=sys.stderr)
             return 1
