@@ -4,7 +4,7 @@ and functions mean what rubass.lang.ops says, as in the checker's constant foldi
 from __future__ import annotations
 
 import math
-from typing import Any, Callable, Dict, List, Optional, Tuple
+from typing import Any, Callable, Dict, List, Optional, Sequence, Tuple
 
 from ..lang import ast
 from ..lang.geometry import boundary_distance, inside
@@ -72,7 +72,11 @@ class Compiler:
             return lambda: op1(inner())
         if isinstance(e, ast.Binary) and e.op in ("and", "or") and isinstance(e.left, ast.Binary) \
                 and e.left.op == e.op:
-            terms = tuple(self._fn(t, ops, cell) for t in ast.chain(e, e.op))
+            parts = ast.chain(e, e.op)
+            n_ops = len(ops)
+            terms = tuple(self._fn(t, ops, cell) for t in parts)
+            if len(ops) == n_ops:  # no operator in any term: the first decisive one ends it
+                return _decided_chain(e.op, terms, parts, store)
             join = k_and if e.op == "and" else k_or
 
             def chain() -> Any:  # every term, always: their operators see every evaluation
@@ -171,3 +175,33 @@ def _kept(fn: Fn, read: Fn, limits: Optional[Fn]) -> Fn:
         last[0], last[1], last[2] = arr, lim, value
         return value
     return apply
+
+
+def _decided_chain(op: str, terms: Tuple[Fn, ...], parts: Sequence[ast.Expr], store: Store) -> Fn:
+    """A Kleene `and`/`or` of stateless terms, short-circuited: `or` is true at the first true
+    term, `and` false at the first false one; else unknown if any term is not a boolean.
+    A chain of rule names (a behaviour over many rules) reads the rules' values directly."""
+    decisive, neutral = (True, False) if op == "or" else (False, True)
+    if all(isinstance(t, ast.RuleRef) for t in parts):
+        get, keys = store.rules.get, tuple(t.key for t in parts)  # type: ignore[attr-defined]
+
+        def rules() -> Any:
+            unknown = False
+            for v in map(get, keys):
+                if v is decisive:
+                    return decisive
+                if v is not neutral:
+                    unknown = True  # unknown, or not evaluated yet (None)
+            return UNKNOWN if unknown else neutral
+        return rules
+
+    def chain() -> Any:
+        unknown = False
+        for t in terms:
+            v = t()
+            if v is decisive:
+                return decisive
+            if v is not neutral:
+                unknown = True
+        return UNKNOWN if unknown else neutral
+    return chain

@@ -1,0 +1,70 @@
+"""`and`/`or` chains without operators are short-circuited (issue 17): the value must still be
+the Kleene fold of every term, whatever the order of true, false and unknown terms."""
+import math
+import os
+from functools import reduce
+
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from rubass.engine.evaluate import Compiler
+from rubass.engine.store import Store
+from rubass.engine.values import UNKNOWN, k_and, k_or
+from rubass.lang import check_text
+
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+LIB = os.path.join(ROOT, "docs", "examples", "actions.yaml")
+N = 6
+RULES = "\n".join(f"  r{i}: topic /t{i}.data > 0;" for i in range(N))
+SPEC = ("action primitive warn;\nentity e { rules:\n" + RULES + "\n}\n"
+        + "if (" + " or ".join(f"e.r{i}" for i in range(N)) + ") then { warn; }\n"
+        + "if (" + " and ".join(f"e.r{i}" for i in range(N)) + ") then { warn; }\n"
+        # stateless terms that are not rule names: fields read directly
+        + "if (" + " or ".join(f"topic /t{i}.data > 0" for i in range(N)) + ") then { warn; }\n"
+        + "if (" + " and ".join(f"topic /t{i}.data > 0" for i in range(N)) + ") then { warn; }\n")
+KLEENE = st.sampled_from([True, False, UNKNOWN, None])  # None: a rule not evaluated yet
+FIELD = st.sampled_from([1.0, -1.0, math.nan, UNKNOWN])
+
+
+def _compiled():
+    spec = check_text(SPEC, os.path.join(ROOT, "x.rbs"), [LIB])
+    store = Store(0.0)
+    compiler = Compiler(store, {"warn": [False]})
+    return store, [compiler.compile(b.cond).fn for b in spec.behaviours]
+
+
+STORE, FNS = _compiled()
+
+
+@settings(max_examples=400, deadline=None)
+@given(st.lists(KLEENE, min_size=N, max_size=N))
+def test_a_chain_of_rule_names_is_the_kleene_fold_of_its_rules(values):
+    STORE.rules.clear()
+    STORE.rules.update({f"e.r{i}": v for i, v in enumerate(values) if v is not None})
+    known = [UNKNOWN if v is None else v for v in values]
+    assert FNS[0]() is reduce(k_or, known)
+    assert FNS[1]() is reduce(k_and, known)
+
+
+@settings(max_examples=400, deadline=None)
+@given(st.lists(FIELD, min_size=N, max_size=N))
+def test_a_chain_of_comparisons_is_the_kleene_fold_of_its_terms(values):
+    for i, v in enumerate(values):
+        STORE.cell((f"/t{i}", ("data",)))[0] = v
+    terms = [UNKNOWN if v is UNKNOWN or v != v else v > 0 for v in values]
+    assert FNS[2]() is reduce(k_or, terms)
+    assert FNS[3]() is reduce(k_and, terms)
+
+
+def test_a_term_with_an_operator_is_still_evaluated_every_time():
+    # `for` inside a chain must see every evaluation, even when an earlier term decides it
+    spec = check_text("action primitive warn;\nentity e { rules: a: topic /a.data > 0; b: topic /b.data > 0; }\n"
+                      "if (e.a or (e.b for 1 s)) then { warn; }\n", os.path.join(ROOT, "x.rbs"), [LIB])
+    store = Store(0.0)
+    compiled = Compiler(store, {"warn": [False]}).compile(spec.behaviours[0].cond)
+    store.cell(("/b", ("data",)))[0] = 1.0
+    store.rules.update({"e.a": True, "e.b": True})
+    compiled.fn()  # e.a decides, and e.b's `for` starts counting now, at 0
+    store.rules["e.a"] = False
+    store.now = 1.0
+    assert compiled.fn() is True  # e.b has held for 1 s: the `for` saw the first evaluation
