@@ -14,6 +14,7 @@ from __future__ import annotations
 import re
 import string
 import sys
+from bisect import bisect_right
 from typing import Any, List, Optional, Tuple
 
 from . import ast
@@ -35,9 +36,17 @@ _NODE_NAME = re.compile(rf"{_WS}({_GRAPH_RE})")
 # pyparsing's Keyword refuses a keyword that follows one of these characters without a space
 _KEYWORD_CHARS = frozenset(string.ascii_letters + string.digits + "_$")
 
-# How many interpreter frames pyparsing spends on one level of each nesting: past a share of the
-# recursion limit, pyparsing decides (it may report "nested too deeply" where this parser would not)
+# About how many interpreter frames pyparsing spends on one level of each nesting (a little more
+# than pyparsing 3.0 does): past 40 % of the stack left, pyparsing decides (it may then report
+# "nested too deeply", where this parser would not)
 _PAREN, _CALL, _MINUS, _NOT = 20, 28, 8, 2
+
+
+def _stack_depth() -> int:
+    frame, depth = sys._getframe(), 0
+    while frame is not None:
+        frame, depth = frame.f_back, depth + 1  # type: ignore[assignment]
+    return depth
 
 
 class NotAccepted(Exception):
@@ -48,12 +57,13 @@ class _Parser:
     """Recursive descent over a lazily lexed token stream; one token of lookahead."""
 
     def __init__(self, text: str, source: Source) -> None:
-        self.s, self.src = text, source
+        self.s, self.src, self.name = text, source, source.name
+        self.lines = source._line_starts  # the offset of each line's start
         self.kind: str = ""
         self.text: Optional[str] = ""
         self.unit: Optional[str] = None
         self.start = self.end = 0
-        self.depth, self.max_depth = 0, sys.getrecursionlimit() * 2 // 5
+        self.depth, self.max_depth = 0, (sys.getrecursionlimit() - _stack_depth()) * 2 // 5
         self.lex(0)
 
     # ---- tokens ----------------------------------------------------------------------
@@ -87,7 +97,9 @@ class _Parser:
         return start
 
     def span(self, start: int, end: int = -1) -> Span:
-        return self.src.span(start, end)
+        """Source.span(start, end), without its clamping (offsets here are inside the text)."""
+        line = bisect_right(self.lines, start)
+        return Span(self.name, line, start - self.lines[line - 1] + 1, start, start if end < 0 else end)
 
     def ident(self) -> ast.Ident:
         """A name that is not a keyword (pyparsing: ident_node, label_name)."""

@@ -21,7 +21,7 @@ from rubass.lang.source import Source
 
 from conftest import ROOT, SHARED
 
-CHECK = settings(max_examples=300, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+CHECK = settings(max_examples=200, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 
 
 def same_tree(ref, fast, path="spec"):
@@ -332,3 +332,18 @@ def test_syntax_errors_are_unchanged(text, message):
     with pytest.raises(SpecError) as ref:
         parse_source(Source("bad.rbs", text), fast=False)
     assert str(ref.value) == str(fast.value)
+
+
+def test_deep_nesting_is_left_to_pyparsing_when_the_stack_is_short_too():
+    """Called with most of the stack used already, the fast parser declines sooner."""
+    text = "const x = " + "(" * 12 + "1" + ")" * 12 + ";"
+
+    def nest(n):
+        return nest(n - 1) if n else parse_fast(Source("t.rbs", text))
+
+    import sys
+
+    from rubass.lang.fastparse import _stack_depth
+
+    assert parse_fast(Source("t.rbs", text)) is not None
+    assert nest(sys.getrecursionlimit() - _stack_depth() - 150) is None
