@@ -4,6 +4,7 @@ and functions mean what rubass.lang.ops says, as in the checker's constant foldi
 from __future__ import annotations
 
 import math
+import operator
 from typing import Any, Callable, Dict, List, Optional, Sequence, Tuple
 
 from ..lang import ast
@@ -87,6 +88,9 @@ class Compiler:
             return chain
         if isinstance(e, ast.Binary):
             left, right, op2 = self._fn(e.left, ops, cell), self._fn(e.right, ops, cell), BINARY[e.op]
+            fast = _compare_with_constant(e, left, right)
+            if fast is not None:
+                return fast
             return lambda: op2(left(), right())  # both sides always: their operators see every evaluation
         if isinstance(e, (ast.For, ast.Within)):
             operand = self._fn(e.operand, ops, cell)
@@ -205,3 +209,27 @@ def _decided_chain(op: str, terms: Tuple[Fn, ...], parts: Sequence[ast.Expr], st
                 unknown = True
         return UNKNOWN if unknown else neutral
     return chain
+
+
+_COMPARE = {"<": operator.lt, "<=": operator.le, ">": operator.gt, ">=": operator.ge}
+_MIRROR = {"<": ">", "<=": ">=", ">": "<", ">=": "<="}  # c < x is x > c
+
+
+def _compare_with_constant(e: ast.Binary, left: Fn, right: Fn) -> Optional[Fn]:
+    """`x > 0.5` and the like, with a number on one side: the same value as BINARY's
+    comparison (unknown unless x is a float that is not NaN), in one closure and one C call."""
+    if e.op not in _COMPARE:
+        return None
+    if isinstance(e.right, ast.Lit) and type(e.right.value) is float and e.right.value == e.right.value:
+        x, const, cmp = left, e.right.value, _COMPARE[e.op]
+    elif isinstance(e.left, ast.Lit) and type(e.left.value) is float and e.left.value == e.left.value:
+        x, const, cmp = right, e.left.value, _COMPARE[_MIRROR[e.op]]
+    else:
+        return None
+
+    def compare() -> Any:
+        v = x()
+        if type(v) is float and v == v:
+            return cmp(v, const)
+        return UNKNOWN
+    return compare

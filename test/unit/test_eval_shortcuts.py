@@ -1,5 +1,6 @@
-"""`and`/`or` chains without operators are short-circuited (issue 17): the value must still be
-the Kleene fold of every term, whatever the order of true, false and unknown terms."""
+"""Evaluation shortcuts (issue 17) give the values of the general path: `and`/`or` chains
+without operators are short-circuited (still the Kleene fold of every term, whatever the order
+of true, false and unknown terms), and a comparison with a number is one closure."""
 import math
 import os
 from functools import reduce
@@ -68,3 +69,23 @@ def test_a_term_with_an_operator_is_still_evaluated_every_time():
     store.rules["e.a"] = False
     store.now = 1.0
     assert compiled.fn() is True  # e.b has held for 1 s: the `for` saw the first evaluation
+
+
+ANY_VALUE = st.one_of(st.floats(allow_nan=True, allow_infinity=True), st.sampled_from([UNKNOWN, True, False, 0, 1, "x"]))
+
+
+@settings(max_examples=300, deadline=None)
+@given(st.sampled_from(["<", "<=", ">", ">="]), st.floats(allow_nan=False, allow_infinity=True), ANY_VALUE,
+       st.booleans())
+def test_a_comparison_with_a_number_is_the_operator_tables_comparison(op, const, value, const_left):
+    from rubass.engine.evaluate import _compare_with_constant
+    from rubass.lang import ast
+    from rubass.lang.ops import BINARY
+
+    x = ast.TopicRef("/t", ("data",))
+    c = ast.Lit(const)
+    e = ast.Binary(op, c, x) if const_left else ast.Binary(op, x, c)
+    fast = _compare_with_constant(e, lambda: const if const_left else value, lambda: value if const_left else const)
+    assert fast is not None
+    expected = BINARY[op](const, value) if const_left else BINARY[op](value, const)
+    assert fast() is expected
