@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import functools
 import math
+import sys
 from dataclasses import replace
 from typing import Any, FrozenSet, List, Tuple
 
@@ -11,7 +12,14 @@ from . import ast
 from .geometry import polygon_problem
 from .units import COUNT, DIMENSIONLESS, FREQUENCY, LENGTH, MEMORY, TIME, dim_mul
 
-# Ty, BOOL, … live in typecheck; imported lazily there to avoid a cycle.
+# Ty, BOOL, … live in typecheck, which imports this module: _types() finds it when a check runs
+# (an import statement in each method would cost more than the method's own work).
+_TYPECHECK = __name__.rsplit(".", 1)[0] + ".typecheck"
+
+
+def _types() -> Any:
+    """The typecheck module (always imported by then: only its ExprChecker runs these methods)."""
+    return sys.modules[_TYPECHECK]
 
 
 _TOPIC_FORMS = {"frequency": "frequency(topic /t) or frequency(topic /t, 2 s)", "age": "age(topic /t)",
@@ -35,7 +43,7 @@ class BuiltinChecks:
     quant: Any
 
     def _builtin(self, e: ast.Call) -> Tuple[ast.Expr, Any]:
-        from .typecheck import ANY
+        ANY = _types().ANY
         f = e.func
         if f in ("frequency", "age", "stamp_age"):
             return self._topic_fn(e)
@@ -64,7 +72,8 @@ class BuiltinChecks:
             self.error(e.span, f"a constant cannot use {e.func}()")  # type: ignore[attr-defined]
 
     def _topic_fn(self, e: ast.Call) -> Tuple[ast.Expr, Any]:
-        from .typecheck import ANY, num
+        tc = _types()
+        ANY, num = tc.ANY, tc.num
         args = list(e.args)
         self._dynamic_only(e)
         max_args = 2 if e.func == "frequency" else 1
@@ -96,7 +105,8 @@ class BuiltinChecks:
         return ast.Frequency(ref.topic, window, span=e.span), num(FREQUENCY)
 
     def _node_fn(self, e: ast.Call) -> Tuple[ast.Expr, Any]:
-        from .typecheck import ANY, BOOL, num
+        tc = _types()
+        ANY, BOOL, num = tc.ANY, tc.BOOL, tc.num
         self._dynamic_only(e)
         if len(e.args) != 1 or not isinstance(e.args[0], ast.NodeRef):
             self.error(e.span, f"{e.func}() is written {e.func}(node /name)")  # type: ignore[attr-defined]
@@ -111,7 +121,8 @@ class BuiltinChecks:
         return ast.NodeStat(ref.node, e.func, span=e.span), ty
 
     def _rate(self, e: ast.Call) -> Tuple[ast.Expr, Any]:
-        from .typecheck import ANY, num
+        tc = _types()
+        ANY, num = tc.ANY, tc.num
         self._dynamic_only(e)
         if len(e.args) != 1 or not isinstance(e.args[0], ast.TopicRef) or not e.args[0].path:
             self.error(e.span, "rate() takes a topic field: rate(topic /odom.twist.twist.linear.x)")  # type: ignore[attr-defined]
@@ -122,7 +133,7 @@ class BuiltinChecks:
             return e, ANY
         _, fty = self.check(ref)  # type: ignore[attr-defined]
         if fty.kind not in ("num", "any"):
-            from .typecheck import _describe
+            _describe = _types()._describe
             self.error(ref.span, f"rate() needs a number, not a {_describe(fty)}")  # type: ignore[attr-defined]
         dim = None if fty.kind != "num" or fty.dim is None else dim_mul(fty.dim, TIME, -1)
         return ast.Rate(ref, span=e.span), num(dim)
@@ -136,7 +147,8 @@ class BuiltinChecks:
         return replace(ref, path=ref.path[:i + 1]), ref.path[i + 1:]
 
     def _array_fn(self, e: ast.Call) -> Tuple[ast.Expr, Any]:
-        from .typecheck import ANY, num
+        tc = _types()
+        ANY, num = tc.ANY, tc.num
         arg = e.args[0]
         if not isinstance(arg, ast.TopicRef) or not arg.path:
             what = "an array field such as 'topic /scan.ranges'" if e.func == "len" else \
@@ -152,7 +164,8 @@ class BuiltinChecks:
         return out, (num(COUNT) if e.func == "len" else num(ety.dim if ety.kind == "num" else None))
 
     def _quantifier(self, e: ast.Call) -> Tuple[ast.Expr, Any]:
-        from .typecheck import ANY, BOOL, _Quant, num
+        tc = _types()
+        ANY, BOOL, _Quant, num = tc.ANY, tc.BOOL, tc._Quant, tc.num
         self._dynamic_only(e)
         if len(e.args) != 1:
             self.error(e.span, f"{e.func}() takes one condition over an array, e.g. "  # type: ignore[attr-defined]
@@ -185,7 +198,8 @@ class BuiltinChecks:
 
     # -- logic over time and actions -------------------------------------------------------
     def _latch(self, e: ast.Call) -> Tuple[ast.Expr, Any]:
-        from .typecheck import ANY, BOOL
+        tc = _types()
+        ANY, BOOL = tc.ANY, tc.BOOL
         self._dynamic_only(e)
         if len(e.args) != 2:
             self.error(e.span, "latch() is written latch(SET, RESET), e.g. "  # type: ignore[attr-defined]
@@ -197,7 +211,8 @@ class BuiltinChecks:
         return ast.Latch(s, r, span=e.span), BOOL
 
     def _active(self, e: ast.Call) -> Tuple[ast.Expr, Any]:
-        from .typecheck import ANY, BOOL
+        tc = _types()
+        ANY, BOOL = tc.ANY, tc.BOOL
         self._dynamic_only(e)
         arg = e.args[0] if len(e.args) == 1 else None
         if not isinstance(arg, ast.Name) or len(arg.parts) != 1:
@@ -216,7 +231,8 @@ class BuiltinChecks:
 
     # -- zones -----------------------------------------------------------------------------
     def _polygon(self, e: ast.Call) -> Tuple[ast.Expr, Any]:
-        from .typecheck import ANY, Ty
+        tc = _types()
+        ANY, Ty = tc.ANY, tc.Ty
         points: List[Tuple[float, float]] = []
         dims = set()
         ok = True
@@ -256,7 +272,8 @@ class BuiltinChecks:
                                                        bare=dims == {"bare"})
 
     def _zone(self, e: ast.Call) -> Tuple[ast.Expr, Any]:
-        from .typecheck import ANY, BOOL, Ty
+        tc = _types()
+        ANY, BOOL, Ty = tc.ANY, tc.BOOL, tc.Ty
         if len(e.args) != 3:
             self.error(e.span, f"{e.func}() is written {e.func}(X, Y, AREA) with AREA a polygon constant")  # type: ignore[attr-defined]
             return e, ANY

@@ -8,7 +8,7 @@ import contextlib
 import dataclasses
 import gc
 import os
-from typing import Dict, FrozenSet, Iterator, List, Optional, Sequence, Set, Tuple
+from typing import Any, Callable, Dict, FrozenSet, Iterator, List, Optional, Sequence, Set, Tuple
 
 from . import ast
 from .errors import Diagnostic, did_you_mean
@@ -417,6 +417,8 @@ def _uses(exprs: Sequence[ast.Expr]) -> Tuple[Dict[str, TopicUse], FrozenSet[str
     nodes: Set[str] = set()
     for e in (x for expr in exprs for x in _walk(expr)):
         t = type(e)  # the node types are final: `is` is an exact isinstance
+        if t not in _USE_KINDS:
+            continue
         if t is ast.TopicRef:
             paths.setdefault(e.topic, set())  # type: ignore[union-attr]
             if e.path:  # type: ignore[union-attr]
@@ -430,11 +432,14 @@ def _uses(exprs: Sequence[ast.Expr]) -> Tuple[Dict[str, TopicUse], FrozenSet[str
     return {t: TopicUse(t, frozenset(p)) for t, p in paths.items()}, frozenset(nodes)
 
 
-# The sub-expression fields of each expression type, as ast.children gives them (Call: its args).
-_KIDS: Dict[type, Tuple[str, ...]] = {
-    ast.Unary: ("operand",), ast.Binary: ("left", "right"), ast.For: ("operand", "duration"),
-    ast.Within: ("operand", "duration"), ast.Pair: ("x", "y"), ast.Rate: ("ref",), ast.ArrayFn: ("ref",),
-    ast.Quant: ("ref", "body"), ast.Latch: ("set", "reset"), ast.Zone: ("x", "y")}
+_USE_KINDS = frozenset({ast.TopicRef, ast.Age, ast.Frequency, ast.StampAge, ast.NodeStat})
+
+# The sub-expressions of each expression type, as ast.children gives them.
+_KIDS: Dict[type, Callable[[Any], Sequence[ast.Expr]]] = {
+    ast.Call: lambda e: e.args, ast.Unary: lambda e: (e.operand,), ast.Binary: lambda e: (e.left, e.right),
+    ast.For: lambda e: (e.operand, e.duration), ast.Within: lambda e: (e.operand, e.duration),
+    ast.Pair: lambda e: (e.x, e.y), ast.Rate: lambda e: (e.ref,), ast.ArrayFn: lambda e: (e.ref,),
+    ast.Quant: lambda e: (e.ref, e.body), ast.Latch: lambda e: (e.set, e.reset), ast.Zone: lambda e: (e.x, e.y)}
 
 
 def _walk(expr: ast.Expr) -> List[ast.Expr]:
@@ -442,14 +447,11 @@ def _walk(expr: ast.Expr) -> List[ast.Expr]:
     chain of isinstance tests (the checker walks every expression of the spec)."""
     out: List[ast.Expr] = []
     stack = [expr]
+    kids = _KIDS.get
     while stack:
         e = stack.pop()
         out.append(e)
-        t = type(e)
-        if t is ast.Call:
-            stack.extend(e.args)  # type: ignore[union-attr]
-        else:
-            names = _KIDS.get(t)
-            if names is not None:
-                stack.extend([getattr(e, n) for n in names])
+        sub = kids(type(e))
+        if sub is not None:
+            stack.extend(sub(e))
     return out
