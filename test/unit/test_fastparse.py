@@ -21,7 +21,7 @@ from rubass.lang.source import Source
 
 from conftest import ROOT, SHARED
 
-CHECK = settings(max_examples=200, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+CHECK = settings(max_examples=80, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 
 
 def same_tree(ref, fast, path="spec"):
