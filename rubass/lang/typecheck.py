@@ -33,6 +33,8 @@ class Ty:
 
 
 ANY = Ty("any")
+_CONDITION = ("bool", "any")  # the kinds a condition may have
+_NUMBER = ("num", "any")  # the kinds a number may have
 BOOL = Ty("bool")
 STR = Ty("str")
 BARE = Ty("num", DIMENSIONLESS, bare=True)
@@ -48,9 +50,6 @@ def num(d: Optional[Dimension]) -> Ty:
         ty = _NUM_TYS.setdefault(d, Ty("num", d))
     return ty
 
-
-# expression type -> the name of the ExprChecker method that checks it ('_binary' for Binary)
-_METHOD_NAMES: Dict[type, str] = {}
 
 Resolution = Union[Tuple[str, ast.Expr, Ty], str]  # ('const'|'rule', expr, ty) or an error message
 
@@ -79,6 +78,12 @@ class _Quant:
 class ExprChecker(BuiltinChecks):
     """Checks one expression and returns its checked form; diagnostics go to `diags`."""
 
+    _methods: Dict[type, Callable[..., Tuple[ast.Expr, Ty]]] = {}  # expression type -> its check
+
+    def __init_subclass__(cls, **kwargs: Any) -> None:
+        super().__init_subclass__(**kwargs)
+        cls._methods = {}  # a subclass may override a check: a table of its own
+
     def __init__(self, scope: Scope, diags: List[Diagnostic]) -> None:
         self.scope, self.diags = scope, diags
         self.quant: Optional[_Quant] = None
@@ -94,10 +99,11 @@ class ExprChecker(BuiltinChecks):
         return out
 
     def check(self, expr: ast.Expr) -> Tuple[ast.Expr, Ty]:
-        name = _METHOD_NAMES.get(type(expr))
-        if name is None:
-            name = _METHOD_NAMES.setdefault(type(expr), "_" + type(expr).__name__.lower())
-        return getattr(self, name)(expr)  # type: ignore[no-any-return]
+        method = self._methods.get(type(expr))
+        if method is None:
+            method = getattr(type(self), "_" + type(expr).__name__.lower())  # _binary for Binary
+            self._methods[type(expr)] = method
+        return method(self, expr)  # type: ignore[no-any-return]
 
     # -- leaves --------------------------------------------------------------------------
     def _num(self, e: ast.Num) -> Tuple[ast.Expr, Ty]:
@@ -211,10 +217,12 @@ class ExprChecker(BuiltinChecks):
         spans.reverse()
         terms = ast.chain(e, e.op)
         out, ty = self.check(terms[0])
-        self._want_bool(ty, terms[0].span, f"'{e.op}'")
+        if ty.kind not in _CONDITION:
+            self._want_bool(ty, terms[0].span, f"'{e.op}'")
         for term, span in zip(terms[1:], spans):
             right, rt = self.check(term)
-            self._want_bool(rt, term.span, f"'{e.op}'")
+            if rt.kind not in _CONDITION:
+                self._want_bool(rt, term.span, f"'{e.op}'")
             out = _fold(ast.Binary(e.op, out, right, span=span))
         return out, BOOL
 
@@ -229,21 +237,21 @@ class ExprChecker(BuiltinChecks):
         out = ast.Binary(e.op, left, right, e.span)
         op = e.op
         if op in ("and", "or"):
-            self._want_bool(lt, e.left.span, f"'{op}'")
-            self._want_bool(rt, e.right.span, f"'{op}'")
+            if lt.kind not in _CONDITION or rt.kind not in _CONDITION:  # the message only when needed
+                self._want_bool(lt, e.left.span, f"'{op}'")
+                self._want_bool(rt, e.right.span, f"'{op}'")
             return _fold(out), BOOL
         if op in ("==", "!="):
             if lt.kind != rt.kind and "any" not in (lt.kind, rt.kind):
                 self.error(e.span, f"'{op}' compares a {_describe(lt)} with a {_describe(rt)}")
             self._same_dim(lt, rt, e.span, "compares {} with {}")
             return _fold(out), BOOL
-        if op in ("<", "<=", ">", ">="):
+        if lt.kind not in _NUMBER or rt.kind not in _NUMBER:  # the message only when needed
             self._want_num(lt, e.left.span, f"'{op}'")
             self._want_num(rt, e.right.span, f"'{op}'")
+        if op in ("<", "<=", ">", ">="):
             self._same_dim(lt, rt, e.span, "compares {} with {}")
             return _fold(out), BOOL
-        self._want_num(lt, e.left.span, f"'{op}'")
-        self._want_num(rt, e.right.span, f"'{op}'")
         if op in ("+", "-"):
             self._same_dim(lt, rt, e.span, "cannot add or subtract {} and {}")
             return _fold(out), _join(lt, rt)
@@ -261,7 +269,8 @@ class ExprChecker(BuiltinChecks):
         if not self.scope.dynamic:
             self.error(e.span, f"a constant cannot use '{word}'")
         operand, ty = self.check(e.operand)
-        self._want_bool(ty, e.operand.span, f"'{word}'")
+        if ty.kind not in _CONDITION:
+            self._want_bool(ty, e.operand.span, f"'{word}'")
         duration, dty = self.check(e.duration)
         if not isinstance(duration, ast.Lit) or not isinstance(duration.value, float):
             if _constant(duration) and dty.kind == "num":
@@ -299,7 +308,8 @@ class ExprChecker(BuiltinChecks):
         args, tys = [], []
         for a in e.args:
             out, ty = self.check(a)
-            self._want_num(ty, a.span, f"{e.func}()")
+            if ty.kind not in _NUMBER:
+                self._want_num(ty, a.span, f"{e.func}()")
             args.append(out)
             tys.append(ty)
         result = tys[0]
