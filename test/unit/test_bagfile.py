@@ -246,3 +246,22 @@ def test_unknown_compression_falls_back_to_rosbag(tmp_path):
         with pytest.raises(BagError, match="compression"):
             list(read(bag, ["/a"], {"/a"}))
     assert os.path.exists(path)
+
+
+def test_a_replay_is_the_same_with_either_reader():
+    from conftest import ROOT
+    from rubass.lang import load_spec
+    from rubass.replay.run import replay
+    from rubass.ros.bag import _read_rosbag
+
+    spec = load_spec(os.path.join(ROOT, "test", "data", "turtlebot_gap.rbs"))
+    path = shared_path("data", "turtlebot3_sim.bag")
+    bag, info = open_bag(path)
+    topics = [t for t in spec.topics if t in info.types]
+    decode = {t for t in topics if spec.topics[t].needs_data}
+    with bag, rosbag.Bag(path) as rb:
+        ours = replay(spec, read(bag, topics, decode), info.start, info.end)[1]
+        theirs = replay(spec, _read_rosbag(rb, topics, decode), info.start, info.end)[1]
+    assert [(e.time, e.kind, e.behaviour, e.rule, e.value) for e in ours] == \
+        [(e.time, e.kind, e.behaviour, e.rule, e.value) for e in theirs]
+    assert sum(e.kind == "start" for e in ours) >= 2
