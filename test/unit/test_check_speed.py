@@ -2,6 +2,7 @@
 cycle messages and the expression walk are pinned here, and the check is linear in the number
 of rules (counted in function calls, not wall time, so that a loaded machine cannot flake it)."""
 import cProfile
+import dataclasses
 import os
 import pstats
 
@@ -153,6 +154,17 @@ def test_the_checker_walk_is_ast_walk():
             "NodeStat", "Active", "For"} <= kinds
     assert set(spec.topics) == {"/d", "/s", "/o", "/imu"}
     assert spec.nodes == frozenset({"/n"})
+
+
+def test_the_checker_walk_knows_every_node_type_that_ast_walk_knows():
+    """A node type added to ast.children must be added to the checker's walk too."""
+    for cls in vars(ast).values():
+        if not (isinstance(cls, type) and dataclasses.is_dataclass(cls)):
+            continue
+        values = {f.name: (ast.Lit(1.0), ast.Lit(2.0)) if f.name == "args" else ast.Lit(float(i))
+                  for i, f in enumerate(dataclasses.fields(cls)) if f.name != "span"}
+        node = cls(**values)
+        assert _walk(node) == list(ast.walk(node)), cls.__name__
 
 
 def _check_calls(text):
