@@ -13,7 +13,6 @@ from __future__ import annotations
 import bz2
 import os
 import struct
-from bisect import bisect_left
 from dataclasses import dataclass, field
 from typing import Any, Callable, Dict, Iterable, Iterator, List, Optional, Set, Tuple
 
@@ -329,22 +328,40 @@ class BagFile:
                 cls = self._class(conn) if conn.topic in decode else None
                 conns[conn.id] = (ranks[conn.id], conn.topic, cls)
         chunks = sorted((c for c in self.chunks if any(k in conns for k in c.counts)), key=lambda c: (c.start, c.index))
-        held: List[Tuple[float, str, Any]] = []
+        held: List[Tuple[float, str, Any]] = []  # messages at or after the next chunk's start
         held_keys: List[int] = []
         for i, chunk in enumerate(chunks):
-            items, keys, in_order = self._scan(chunk, conns, nconn)
-            if held:
-                in_order = in_order and (not keys or held_keys[-1] <= keys[0])
-                items, keys = held + items, held_keys + keys
-            if not in_order:  # a stable sort keeps equal stamps of one connection in file order
+            buf, items, records, in_order = self._scan(chunk, conns)
+
+            def key(j: int, buf: bytes = buf, records: List[int] = records) -> int:
+                """The order key of the chunk's j-th message: (stamp in ns, connection's rank)."""
+                fields, _, _ = _record(buf, records[j])
+                return _time(fields, "time") * nconn + conns[_int(fields, "conn", "I")][0]
+
+            if not in_order or (held and items and held_keys[-1] > key(0)):
+                # a stable sort keeps equal stamps of one connection in file order
+                keys = held_keys + [key(j) for j in range(len(items))]
+                items = held + items
                 order = sorted(range(len(keys)), key=keys.__getitem__)
                 items, keys = [items[j] for j in order], [keys[j] for j in order]
-            cut = bisect_left(keys, chunks[i + 1].start * nconn) if i + 1 < len(chunks) else len(keys)
-            held, held_keys = items[cut:], keys[cut:]
-            if cut == len(items):
-                yield from items
+                key_of = keys.__getitem__
+            elif held:
+                items = held + items
+                key_of = (lambda j, h=len(held), hk=held_keys, k=key: hk[j] if j < h else k(j - h))
             else:
-                yield from items[:cut]
+                key_of = key
+            cut, held_keys = len(items), []
+            if i + 1 < len(chunks):  # hold back what the next chunk may have to come between
+                limit = chunks[i + 1].start * nconn
+                while cut:
+                    k = key_of(cut - 1)
+                    if k < limit:
+                        break
+                    cut -= 1
+                    held_keys.append(k)
+                held_keys.reverse()
+            held = items[cut:]
+            yield from (items if cut == len(items) else items[:cut])
         yield from held
 
     def _class(self, conn: Connection) -> Any:
@@ -365,20 +382,22 @@ class BagFile:
             raise BagFormatError(f"the chunk at byte {chunk.pos} cannot be decompressed "
                                  f"({exc.__class__.__name__}: {exc})") from None
 
-    def _scan(self, chunk: Chunk, conns: Dict[int, Tuple[int, str, Any]], nconn: int
-              ) -> Tuple[List[Tuple[float, str, Any]], List[int], bool]:
-        """A chunk's wanted messages in file order, their order keys, and whether the keys ascend."""
+    def _scan(self, chunk: Chunk, conns: Dict[int, Tuple[int, str, Any]]
+              ) -> Tuple[bytes, List[Tuple[float, str, Any]], List[int], bool]:
+        """A chunk's data, its wanted messages in file order, where their records start, and whether
+        they are in order (stamp, then connection's rank)."""
         buf = self._chunk_data(chunk)
         n = len(buf)
         items: List[Tuple[float, str, Any]] = []
-        keys: List[int] = []
-        add, add_key = items.append, keys.append
+        records: List[int] = []
+        add, add_record = items.append, records.append
         layout, i_op, i_conn, i_time = _layout(("op", "conn", "time"))
         unpack = layout.unpack_from
-        in_order, last, pos = True, -1, 0
+        in_order, last_secs, last_nsecs, last_rank, pos = True, -1, -1, -1, 0
         get = conns.get
         try:
             while pos < n:
+                record = pos
                 try:
                     r = unpack(buf, pos)
                 except struct.error:
@@ -389,7 +408,6 @@ class BagFile:
                     start = pos + _MSG_PREFIX
                     pos = start + r[-1]
                 else:  # a connection record, or a message laid out otherwise
-                    record = pos
                     fields, start, pos = _record(buf, pos)
                     op = _op(fields)
                     if op == OP_CONNECTION:
@@ -407,23 +425,25 @@ class BagFile:
                 if want is None:
                     continue
                 rank, topic, cls = want
-                key = (secs * NS + nsecs) * nconn + rank
-                if key < last:
+                if secs == last_secs:  # compared part by part: cheaper than one key in ns
+                    if nsecs < last_nsecs or (nsecs == last_nsecs and rank < last_rank):
+                        in_order = False
+                elif secs < last_secs:
                     in_order = False
-                last = key
+                last_secs, last_nsecs, last_rank = secs, nsecs, rank
                 if cls is None:
                     add((secs + nsecs / 1e9, topic, None))
                 else:
                     msg = cls()
                     msg.deserialize(buf[start:pos])
                     add((secs + nsecs / 1e9, topic, msg))
-                add_key(key)
+                add_record(record)
         except BagFormatError as exc:
             raise BagFormatError(f"the chunk at byte {chunk.pos}: {exc}") from None
         except Exception as exc:  # genpy.DeserializationError, struct.error from a damaged message
             raise BagFormatError(f"a message in the chunk at byte {chunk.pos} cannot be read "
                                  f"({exc.__class__.__name__}: {exc})") from None
-        return items, keys, in_order
+        return buf, items, records, in_order
 
     # -- lifecycle -----------------------------------------------------------------------
     def close(self) -> None:

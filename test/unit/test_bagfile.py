@@ -173,6 +173,23 @@ def test_other_header_layouts_and_several_connections_on_one_topic(tmp_path, ord
         assert message_classes(b, ["/x", "/name"]) == first
 
 
+@pytest.mark.parametrize("chunks", [
+    # a stamp split over two chunks, the second in order by itself but starting below the first's tail
+    [[(0, T0, 1, 1.0), (1, T0, 2, 2.0)], [(0, T0, 2, 3.0), (1, T0, 3, 4.0)]],
+    # a stamp split over two chunks, already in order across the boundary
+    [[(0, T0, 1, 1.0), (0, T0, 2, 2.0)], [(1, T0, 2, 3.0), (0, T0, 3, 4.0)]],
+    # overlapping chunks, one connection each, and a third after both
+    [[(0, T0, t, t) for t in range(0, 80, 2)], [(1, T0, t, -t) for t in range(1, 80, 2)], [(0, T0 + 1, 0, 9.0)]],
+    # a chunk written before an earlier one, not overlapping it
+    [[(0, T0 + 5, t, t) for t in range(5)], [(1, T0, t, t) for t in range(5)]],
+])
+def test_chunk_boundaries_and_overlapping_chunks(tmp_path, chunks):
+    conns = [(0, "/p", Float64, "/a"), (1, "/q", Float64, "/b")]
+    chunks = [[(c, s, n, Float64(v)) for c, s, n, v in chunk] for chunk in chunks]
+    mine = assert_reads_as_rosbag(craft_bag(str(tmp_path / "k.bag"), conns, chunks))
+    assert len(mine) == sum(len(c) for c in chunks)
+
+
 # -- the real recordings ------------------------------------------------------------------------
 @pytest.mark.parametrize("name", ["husky_outdoor_2015.bag", "turtlebot3_sim.bag"])
 def test_real_recordings(name):
