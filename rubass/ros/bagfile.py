@@ -10,177 +10,16 @@ Unsupported, so that the caller can use rosbag instead.
 """
 from __future__ import annotations
 
-import bz2
 import os
 import struct
-from dataclasses import dataclass, field
-from typing import Any, Callable, Dict, Iterable, Iterator, List, Optional, Set, Tuple
+from typing import Any, Dict, Iterable, Iterator, List, Optional, Set, Tuple
 
-VERSION_LINE = b"#ROSBAG V2.0\n"
-OP_MSG_DATA, OP_FILE_HEADER, OP_INDEX_DATA, OP_CHUNK, OP_CHUNK_INFO, OP_CONNECTION = 2, 3, 4, 5, 6, 7
-NS = 1000000000
+from .bagrecords import (FIELD_CONN, FIELD_OP, FIELD_TIME, MSG_FIELDS, MSG_HEADER_LEN, MSG_PREFIX, NS, OP_CHUNK,
+                         OP_CHUNK_INFO, OP_CONNECTION, OP_FILE_HEADER, OP_MSG_DATA, TIME, U32, VERSION_LINE,
+                         BagFormatError, Chunk, Connection, Unindexed, Unsupported, decompressor, fields_of,
+                         int_field, message_class, message_layout, op_of, record_at, seconds, str_field, time_field)
 
-_U32 = struct.Struct("<I")
-_TIME = struct.Struct("<II")
-# A message data record whose header holds exactly the fields op, conn and time is parsed with one
-# struct call; writers order the fields differently (rosbag's Python writer: op, conn, time), so a
-# layout is made for each order met: (struct, index of the op field, of conn's name, of time's name).
-_FIELD_OP = b"\x04\x00\x00\x00op=\x02"
-_FIELD_CONN = b"\x09\x00\x00\x00conn="
-_FIELD_TIME = b"\x0d\x00\x00\x00time="
-_PIECES = {"op": ("8s", 1), "conn": ("9sI", 2), "time": ("9sII", 3)}
-Layout = Tuple[struct.Struct, int, int, int]
-_layouts: Dict[Tuple[str, ...], Layout] = {}
-
-
-def _layout(order: Tuple[str, ...]) -> Layout:
-    """The layout of message records whose header fields come in this order."""
-    if order not in _layouts:
-        fmt, at, index = "<I", {}, 1
-        for name in order:
-            fmt += _PIECES[name][0]
-            at[name] = index
-            index += _PIECES[name][1]
-        _layouts[order] = (struct.Struct(fmt + "I"), at["op"], at["conn"], at["time"])
-    return _layouts[order]
-
-
-_MSG_HEADER_LEN = 38
-_MSG_PREFIX = 46  # header length, header, data length
-_MSG_FIELDS = {"op", "conn", "time"}
-
-
-class BagFormatError(Exception):
-    """The file is not a readable bag: the message says what is wrong, in a few words."""
-
-
-class Unindexed(BagFormatError):
-    """The bag has no index (recording interrupted, or the file truncated)."""
-
-
-class Unsupported(Exception):
-    """A bag this reader does not handle (another format version, encryption, a compression)."""
-
-
-@dataclass(frozen=True)
-class Connection:
-    """A connection record: the attributes rosbag's _ConnectionInfo has."""
-    id: int
-    topic: str
-    datatype: str
-    md5sum: str
-    msg_def: str
-    header: Dict[str, bytes] = field(repr=False, compare=False)
-
-
-@dataclass
-class Chunk:
-    """A chunk-info record and its chunk's header: times in nanoseconds."""
-    index: int  # place in the file
-    pos: int
-    start: int
-    end: int
-    counts: Dict[int, int]  # connection id -> messages
-    compression: str = "none"
-    data_pos: int = 0
-    data_len: int = 0
-
-
-def _fields(buf: bytes, pos: int, end: int) -> Dict[str, bytes]:
-    """A record header's name=value fields."""
-    out: Dict[str, bytes] = {}
-    while pos < end:
-        if pos + 4 > end:
-            raise BagFormatError("a record header is cut short")
-        (size,) = _U32.unpack_from(buf, pos)
-        pos += 4
-        if pos + size > end:
-            raise BagFormatError("a record header field runs past its header")
-        name, sep, value = buf[pos:pos + size].partition(b"=")
-        if not sep:
-            raise BagFormatError("a record header field has no '='")
-        out[name.decode("latin-1")] = value
-        pos += size
-    return out
-
-
-def _record(buf: bytes, pos: int) -> Tuple[Dict[str, bytes], int, int]:
-    """(header fields, data start, data end) of the record at pos in buf."""
-    if pos + 4 > len(buf):
-        raise BagFormatError("a record is cut short")
-    (hlen,) = _U32.unpack_from(buf, pos)
-    hend = pos + 4 + hlen
-    if hend + 4 > len(buf):
-        raise BagFormatError("a record header runs past the end of the data")
-    fields = _fields(buf, pos + 4, hend)
-    (dlen,) = _U32.unpack_from(buf, hend)
-    if hend + 4 + dlen > len(buf):
-        raise BagFormatError("a record runs past the end of the data")
-    return fields, hend + 4, hend + 4 + dlen
-
-
-def _int(fields: Dict[str, bytes], name: str, fmt: str) -> int:
-    try:
-        return struct.unpack("<" + fmt, fields[name])[0]
-    except KeyError:
-        raise BagFormatError(f"a record has no field '{name}'") from None
-    except struct.error:
-        raise BagFormatError(f"a record's field '{name}' has the wrong size") from None
-
-
-def _op(fields: Dict[str, bytes]) -> int:
-    return _int(fields, "op", "B")
-
-
-def _time(fields: Dict[str, bytes], name: str) -> int:
-    try:
-        secs, nsecs = _TIME.unpack(fields[name])
-    except KeyError:
-        raise BagFormatError(f"a record has no field '{name}'") from None
-    except struct.error:
-        raise BagFormatError(f"a record's field '{name}' has the wrong size") from None
-    return secs * NS + nsecs
-
-
-def _str(fields: Dict[str, bytes], name: str) -> str:
-    try:
-        return fields[name].decode("utf-8")
-    except KeyError:
-        raise BagFormatError(f"a connection has no field '{name}'") from None
-    except UnicodeDecodeError:
-        raise BagFormatError(f"a connection's field '{name}' is not text") from None
-
-
-def _seconds(ns: int) -> float:
-    """Nanoseconds as seconds, rounded as genpy's Time.to_sec rounds them."""
-    secs, nsecs = divmod(ns, NS)
-    return secs + nsecs / 1e9
-
-
-def _decompressor(name: str) -> Callable[[bytes], bytes]:
-    if name == "none":
-        return lambda data: data
-    if name == "bz2":
-        return bz2.decompress
-    if name == "lz4":
-        try:
-            import roslz4  # what rosbag itself uses (Debian python3-roslz4, a dependency of python3-rosbag)
-        except ImportError:
-            raise Unsupported("lz4 chunks need the roslz4 module") from None
-        return roslz4.decompress  # type: ignore[no-any-return]
-    raise Unsupported(f"chunks compressed with '{name}'")
-
-
-def message_class(conn: Connection) -> Any:
-    """The message class of a connection, as rosbag makes it (from the recorded definition)."""
-    try:
-        from rosbag.bag import _get_message_type  # rosbag's cache: the very classes rosbag yields
-    except ImportError:  # pragma: no cover - rosbag is installed with this reader's users
-        import genpy.dynamic
-
-        return genpy.dynamic.generate_dynamic(conn.datatype, conn.msg_def)[conn.datatype]
-    return _get_message_type(conn)
-
+__all__ = ["BagFile", "BagFormatError", "Chunk", "Connection", "Unindexed", "Unsupported", "message_class"]
 
 class BagFile:
     """An indexed bag v2.0 open for reading; BagFormatError, Unindexed or Unsupported if it cannot be."""
@@ -204,14 +43,14 @@ class BagFile:
                 raise Unsupported(f"bag format {line[9:].strip().decode('latin-1')}")
             raise BagFormatError("no ROS bag version line at its start")
         head = f.read(8192)
-        fields, _, _ = _record(head, 0)
-        if _op(fields) != OP_FILE_HEADER:
+        fields, _, _ = record_at(head, 0)
+        if op_of(fields) != OP_FILE_HEADER:
             raise BagFormatError("no file header record after the version line")
         if "encryptor" in fields and fields["encryptor"]:
             raise Unsupported("an encrypted bag")
-        index_pos = _int(fields, "index_pos", "Q")
-        conn_count = _int(fields, "conn_count", "I")
-        chunk_count = _int(fields, "chunk_count", "I")
+        index_pos = int_field(fields, "index_pos", "Q")
+        conn_count = int_field(fields, "conn_count", "I")
+        chunk_count = int_field(fields, "chunk_count", "I")
         if index_pos == 0:
             raise Unindexed("the bag is not indexed")
         if index_pos > size:
@@ -221,27 +60,27 @@ class BagFile:
         pos = 0
         connections: Dict[int, Connection] = {}
         for _ in range(conn_count):
-            fields, start, end = _record(buf, pos)
-            if _op(fields) != OP_CONNECTION:
+            fields, start, end = record_at(buf, pos)
+            if op_of(fields) != OP_CONNECTION:
                 raise BagFormatError("a connection record is missing from the index")
-            conn_id = _int(fields, "conn", "I")
-            info = _fields(buf, start, end)
-            connections[conn_id] = Connection(conn_id, _str(fields, "topic"), _str(info, "type"),
-                                              _str(info, "md5sum"), _str(info, "message_definition"), info)
+            conn_id = int_field(fields, "conn", "I")
+            info = fields_of(buf, start, end)
+            connections[conn_id] = Connection(conn_id, str_field(fields, "topic"), str_field(info, "type"),
+                                              str_field(info, "md5sum"), str_field(info, "message_definition"), info)
             pos = end
         chunks: List[Chunk] = []
         for i in range(chunk_count):
-            fields, start, end = _record(buf, pos)
-            if _op(fields) != OP_CHUNK_INFO or _int(fields, "ver", "I") != 1:
+            fields, start, end = record_at(buf, pos)
+            if op_of(fields) != OP_CHUNK_INFO or int_field(fields, "ver", "I") != 1:
                 raise BagFormatError("a chunk info record is missing from the index")
             counts = {}
-            for j in range(_int(fields, "count", "I")):
+            for j in range(int_field(fields, "count", "I")):
                 if start + 8 * j + 8 > end:
                     raise BagFormatError("a chunk info record is cut short")
-                conn_id, n = _TIME.unpack_from(buf, start + 8 * j)
+                conn_id, n = TIME.unpack_from(buf, start + 8 * j)
                 counts[conn_id] = n
-            chunks.append(Chunk(i, _int(fields, "chunk_pos", "Q"), _time(fields, "start_time"),
-                                _time(fields, "end_time"), counts))
+            chunks.append(Chunk(i, int_field(fields, "chunk_pos", "Q"), time_field(fields, "start_time"),
+                                time_field(fields, "end_time"), counts))
             pos = end
         for chunk in chunks:
             self._chunk_header(chunk, size)
@@ -264,24 +103,24 @@ class BagFile:
         head = self._file.read(4)
         if len(head) < 4:
             raise BagFormatError(f"the chunk at byte {chunk.pos} is cut short")
-        head += self._file.read(_U32.unpack(head)[0] + 4)
+        head += self._file.read(U32.unpack(head)[0] + 4)
         fields, data_pos = self._header_only(head, chunk)
-        if _op(fields) != OP_CHUNK:
+        if op_of(fields) != OP_CHUNK:
             raise BagFormatError(f"no chunk at byte {chunk.pos}, where the index says one is")
         chunk.compression = fields.get("compression", b"none").decode("latin-1")
         chunk.data_pos = chunk.pos + data_pos
-        chunk.data_len = _U32.unpack_from(head, data_pos - 4)[0]
+        chunk.data_len = U32.unpack_from(head, data_pos - 4)[0]
         if chunk.data_pos + chunk.data_len > size:
             raise BagFormatError(f"the chunk at byte {chunk.pos} runs past the end of the file (truncated?)")
-        _decompressor(chunk.compression)
+        decompressor(chunk.compression)
 
     @staticmethod
     def _header_only(head: bytes, chunk: Chunk) -> Tuple[Dict[str, bytes], int]:
         """A chunk record's header fields and where its data starts (relative to the record)."""
-        hend = 4 + _U32.unpack_from(head, 0)[0]
+        hend = 4 + U32.unpack_from(head, 0)[0]
         if hend + 4 > len(head):
             raise BagFormatError(f"the chunk at byte {chunk.pos} is cut short")
-        return _fields(head, 4, hend), hend + 4
+        return fields_of(head, 4, hend), hend + 4
 
     # -- what it holds -------------------------------------------------------------------
     @property
@@ -291,12 +130,12 @@ class BagFile:
     @property
     def start_time(self) -> float:
         """As rosbag's get_start_time: the first chunk's start (0.0 for an empty bag)."""
-        return _seconds(self.chunks[0].start) if self.chunks and self._counts else 0.0
+        return seconds(self.chunks[0].start) if self.chunks and self._counts else 0.0
 
     @property
     def end_time(self) -> float:
         """As rosbag's get_end_time: the last chunk's end (0.0 for an empty bag)."""
-        return _seconds(self.chunks[-1].end) if self.chunks and self._counts else 0.0
+        return seconds(self.chunks[-1].end) if self.chunks and self._counts else 0.0
 
     def topics(self) -> Dict[str, Tuple[str, int]]:
         """topic -> (type of its first connection, messages), as rosbag's get_type_and_topic_info."""
@@ -335,8 +174,8 @@ class BagFile:
 
             def key(j: int, buf: bytes = buf, records: List[int] = records) -> int:
                 """The order key of the chunk's j-th message: (stamp in ns, connection's rank)."""
-                fields, _, _ = _record(buf, records[j])
-                return _time(fields, "time") * nconn + conns[_int(fields, "conn", "I")][0]
+                fields, _, _ = record_at(buf, records[j])
+                return time_field(fields, "time") * nconn + conns[int_field(fields, "conn", "I")][0]
 
             if not in_order or (held and items and held_keys[-1] > key(0)):
                 # a stable sort keeps equal stamps of one connection in file order
@@ -377,7 +216,7 @@ class BagFile:
         if len(data) != chunk.data_len:
             raise BagFormatError(f"the chunk at byte {chunk.pos} is cut short")
         try:
-            return _decompressor(chunk.compression)(data)
+            return decompressor(chunk.compression)(data)
         except (OSError, ValueError, EOFError, RuntimeError) as exc:  # bz2: OSError; roslz4: RuntimeError
             raise BagFormatError(f"the chunk at byte {chunk.pos} cannot be decompressed "
                                  f"({exc.__class__.__name__}: {exc})") from None
@@ -391,7 +230,7 @@ class BagFile:
         items: List[Tuple[float, str, Any]] = []
         records: List[int] = []
         add, add_record = items.append, records.append
-        layout, i_op, i_conn, i_time = _layout(("op", "conn", "time"))
+        layout, i_op, i_conn, i_time = message_layout(("op", "conn", "time"))
         unpack = layout.unpack_from
         in_order, last_secs, last_nsecs, last_rank, pos = True, -1, -1, -1, 0
         get = conns.get
@@ -402,22 +241,22 @@ class BagFile:
                     r = unpack(buf, pos)
                 except struct.error:
                     r = (0,)
-                if (r[0] == _MSG_HEADER_LEN and r[i_op] == _FIELD_OP and r[i_conn] == _FIELD_CONN
-                        and r[i_time] == _FIELD_TIME):
+                if (r[0] == MSG_HEADER_LEN and r[i_op] == FIELD_OP and r[i_conn] == FIELD_CONN
+                        and r[i_time] == FIELD_TIME):
                     conn, secs, nsecs = r[i_conn + 1], r[i_time + 1], r[i_time + 2]
-                    start = pos + _MSG_PREFIX
+                    start = pos + MSG_PREFIX
                     pos = start + r[-1]
                 else:  # a connection record, or a message laid out otherwise
-                    fields, start, pos = _record(buf, pos)
-                    op = _op(fields)
+                    fields, start, pos = record_at(buf, pos)
+                    op = op_of(fields)
                     if op == OP_CONNECTION:
                         continue
                     if op != OP_MSG_DATA:
                         raise BagFormatError(f"a record with op {op} inside a chunk")
-                    conn, stamp = _int(fields, "conn", "I"), _time(fields, "time")
+                    conn, stamp = int_field(fields, "conn", "I"), time_field(fields, "time")
                     secs, nsecs = divmod(stamp, NS)
-                    if start - record == _MSG_PREFIX and set(fields) == _MSG_FIELDS:  # the next ones likely too
-                        layout, i_op, i_conn, i_time = _layout(tuple(fields))
+                    if start - record == MSG_PREFIX and set(fields) == MSG_FIELDS:  # the next ones likely too
+                        layout, i_op, i_conn, i_time = message_layout(tuple(fields))
                         unpack = layout.unpack_from
                 if pos > n:
                     raise BagFormatError("a message runs past the end of its chunk")
