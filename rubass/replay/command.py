@@ -91,7 +91,11 @@ def run(args: argparse.Namespace) -> int:
                   "agents' /rubass/agent_samples); alive(), cpu() and memory() stay unknown", file=sys.stderr)
         present = [t for t in topic_map if t in info.types]
         decode: Set[str] = {t for t in present if spec.topics[topic_map[t]].needs_data}
-        classes = message_classes(bag, sorted(decode))
+        try:
+            classes = message_classes(bag, sorted(decode))
+        except BagError as exc:
+            print(f"rubass replay: error: {exc}", file=sys.stderr)
+            return 1
         errors = []
         readers = [((t, p), owners) for t, paths in spec.field_readers().items() for p, owners in paths.items()]
         for (topic, path), owners in sorted(readers, key=str):

@@ -72,7 +72,8 @@ def _open_rosbag(path: str) -> Tuple[Any, BagInfo]:
 
 
 def message_classes(bag: Bag, topics: List[str]) -> Dict[str, Any]:
-    """The message class of each topic (that of its first message, so unknown types work too)."""
+    """The message class of each topic (that of its first message, so unknown types work too);
+    BagError if the bag cannot be read."""
     out: Dict[str, Any] = {}
     for topic in topics:
         if isinstance(bag, BagFile):
@@ -83,8 +84,8 @@ def message_classes(bag: Bag, topics: List[str]) -> Dict[str, Any]:
             if cls is not None:
                 out[topic] = cls
             continue
-        for _, raw, _ in bag.read_messages(topics=[topic], raw=True):
-            out[topic] = raw[-1]
+        for _, _, msg in _read_rosbag(bag, [topic], {topic}):
+            out[topic] = type(msg)
             break
     return out
 

@@ -282,3 +282,46 @@ def test_a_replay_is_the_same_with_either_reader():
     assert [(e.time, e.kind, e.behaviour, e.rule, e.value) for e in ours] == \
         [(e.time, e.kind, e.behaviour, e.rule, e.value) for e in theirs]
     assert sum(e.kind == "start" for e in ours) >= 2
+
+
+@pytest.mark.parametrize("compression", ["none", "bz2"])
+def test_random_damage_gives_a_bag_error_or_messages_never_another_exception(tmp_path, compression):
+    import random
+
+    items = [(T0 + i // 10, (i % 10) * 10 ** 8, "/name" if i % 3 else "/x", String(f"m{i}") if i % 3 else Float64(i))
+             for i in range(300)]
+    data = open(write_bag(str(tmp_path / "f.bag"), items, compression, chunk_threshold=1500), "rb").read()
+    rnd = random.Random(4)
+    path = str(tmp_path / "damaged.bag")
+    outcomes = set()
+    for _ in range(150):
+        damaged = bytearray(data)
+        for _ in range(rnd.choice([1, 3, 20])):
+            at = rnd.randrange(len(damaged))
+            damaged[at] = rnd.choice([0, 0xFF, rnd.randrange(256)])
+        with open(path, "wb") as fh:
+            fh.write(damaged)
+        error = _fails(path)  # any exception but BagError fails the test
+        assert error is None or (error.startswith(path + ": ") and "\n" not in error)
+        outcomes.add(error is None)
+    assert outcomes == {True, False}
+
+
+def test_replay_of_a_bag_neither_reader_can_read_is_a_one_line_error(tmp_path, write):
+    import subprocess
+    import sys
+
+    from conftest import ROOT
+
+    path = write_bag(str(tmp_path / "z.bag"), float_items(30), "bz2")
+    data = open(path, "rb").read().replace(b"compression=bz2", b"compression=zzz")
+    with open(path, "wb") as fh:
+        fh.write(data)
+    lib = os.path.join(ROOT, "docs", "examples", "actions.yaml")
+    spec = write("s.rbs", f'import "{lib}";\naction primitive stop;\n'
+                          "entity e { rules: high: topic /a.data > 1; }\nif (e.high) then { stop; }\n")
+    proc = subprocess.run([sys.executable, "-m", "rubass", "replay", spec, path], cwd=ROOT, capture_output=True,
+                          text=True, timeout=120)
+    assert proc.returncode == 1 and "Traceback" not in proc.stderr
+    assert proc.stderr.startswith(f"rubass replay: error: {path}: ") and "compression" in proc.stderr
+    assert len(proc.stderr.strip().splitlines()) == 1
