@@ -15,11 +15,12 @@ import struct
 from typing import Any, Dict, Iterable, Iterator, List, Optional, Set, Tuple
 
 from .bagrecords import (FIELD_CONN, FIELD_OP, FIELD_TIME, MSG_FIELDS, MSG_HEADER_LEN, MSG_PREFIX, NS, OP_CHUNK,
-                         OP_CHUNK_INFO, OP_CONNECTION, OP_FILE_HEADER, OP_MSG_DATA, TIME, U32, VERSION_LINE,
+                         OP_CHUNK_INFO, OP_CONNECTION, OP_FILE_HEADER, OP_MSG_DATA, U32, VERSION_LINE,
                          BagFormatError, Chunk, Connection, Unindexed, Unsupported, decompressor, fields_of,
                          int_field, message_class, message_layout, op_of, record_at, seconds, str_field, time_field)
 
 __all__ = ["BagFile", "BagFormatError", "Chunk", "Connection", "Unindexed", "Unsupported", "message_class"]
+
 
 class BagFile:
     """An indexed bag v2.0 open for reading; BagFormatError, Unindexed or Unsupported if it cannot be."""
@@ -56,7 +57,24 @@ class BagFile:
         if index_pos > size:
             raise Unindexed(f"its index is at byte {index_pos}, past its end ({size} bytes): it is truncated")
         f.seek(index_pos)
-        buf = f.read()
+        connections, chunks = self._index(f.read(), conn_count, chunk_count)
+        for chunk in chunks:
+            self._chunk_header(chunk, size)
+        totals: Dict[int, int] = {}
+        for chunk in chunks:
+            for conn_id, n in chunk.counts.items():
+                if conn_id not in connections:
+                    raise BagFormatError(f"a chunk holds messages of connection {conn_id}, which has no record")
+                totals[conn_id] = totals.get(conn_id, 0) + n
+        # as rosbag: connections without messages are left out
+        self._connections = {c: conn for c, conn in connections.items() if totals.get(c)}
+        self.connections = self._connections
+        self.chunks = chunks
+        self._counts = totals
+
+    @staticmethod
+    def _index(buf: bytes, conn_count: int, chunk_count: int) -> Tuple[Dict[int, Connection], List[Chunk]]:
+        """The connection and chunk-info records that end the file."""
         pos = 0
         connections: Dict[int, Connection] = {}
         for _ in range(conn_count):
@@ -77,24 +95,12 @@ class BagFile:
             for j in range(int_field(fields, "count", "I")):
                 if start + 8 * j + 8 > end:
                     raise BagFormatError("a chunk info record is cut short")
-                conn_id, n = TIME.unpack_from(buf, start + 8 * j)
+                conn_id, n = struct.unpack_from("<II", buf, start + 8 * j)  # connection, messages
                 counts[conn_id] = n
             chunks.append(Chunk(i, int_field(fields, "chunk_pos", "Q"), time_field(fields, "start_time"),
                                 time_field(fields, "end_time"), counts))
             pos = end
-        for chunk in chunks:
-            self._chunk_header(chunk, size)
-        totals: Dict[int, int] = {}
-        for chunk in chunks:
-            for conn_id, n in chunk.counts.items():
-                if conn_id not in connections:
-                    raise BagFormatError(f"a chunk holds messages of connection {conn_id}, which has no record")
-                totals[conn_id] = totals.get(conn_id, 0) + n
-        # as rosbag: connections without messages are left out
-        self._connections = {c: conn for c, conn in connections.items() if totals.get(c)}
-        self.connections = self._connections
-        self.chunks = chunks
-        self._counts = totals
+        return connections, chunks
 
     def _chunk_header(self, chunk: Chunk, size: int) -> None:
         if chunk.pos >= size:
