@@ -453,12 +453,13 @@ class Engine:
         sample (`changed`: the numbers of the field slots it changed, if any), a node that is
         not volatile is skipped when neither a field it reads nor a node it reads changed
         value: it would give the value it has. With `changed` None, every node is evaluated."""
-        store, nodes = self.store, self._nodes
+        store, nodes, rules = self.store, self._nodes, self.store.rules
         moved: Set[int] = set()  # nodes whose value changed in this run
+        incremental = changed is not None
         for i in plan:
             node = nodes[i]
-            if changed is not None and not node.volatile and not node.fresh \
-                    and changed.isdisjoint(node.slots) and moved.isdisjoint(node.inputs):
+            if incremental and not node.volatile and not node.fresh \
+                    and changed.isdisjoint(node.slots) and moved.isdisjoint(node.inputs):  # type: ignore[union-attr]
                 continue
             node.fresh = False
             compiled = node.compiled
@@ -473,9 +474,9 @@ class Engine:
             b = node.behaviour
             if b is None:
                 key = node.key
-                old = store.rules.get(key, UNKNOWN)
-                if value is not old and value != old or key not in store.rules:
-                    store.rules[key] = value
+                old = rules.get(key, _ABSENT)
+                if value is not old:  # rule values are True, False or UNKNOWN: identity is equality
+                    rules[key] = value
                     moved.add(i)
                     events.append(Event(store.now, "rule", rule=key, value=None if value is UNKNOWN else value))
                 continue
@@ -503,6 +504,7 @@ class Engine:
 
 
 STAMP: Tuple[ast.PathElem, ...] = ("header", "stamp")
+_ABSENT = object()  # a rule not evaluated yet
 _NO_FIELDS: FrozenSet[int] = frozenset()  # a tick, a deadline, a node sample: no field changed
 
 

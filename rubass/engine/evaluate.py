@@ -55,6 +55,8 @@ class Compiler:
                 cross.update()
                 return value
             return Compiled(fn, ops)
+        if _kleene(expr):
+            return Compiled(inner, ops)  # already True, False or UNKNOWN: no as_bool call
         return Compiled(lambda: as_bool(inner()), ops)
 
     def _fn(self, e: ast.Expr, ops: List[Any], cell: Optional[List[Any]]) -> Fn:
@@ -97,6 +99,8 @@ class Compiler:
             assert isinstance(e.duration, ast.Lit) and isinstance(e.duration.value, float)
             op = ForOp(e.duration.value) if isinstance(e, ast.For) else WithinOp(e.duration.value)
             ops.append(op)
+            if _kleene(e.operand):
+                return lambda: op.update(store.now, operand())
             return lambda: op.update(store.now, as_bool(operand()))
         if isinstance(e, ast.Latch):
             set_, reset = self._fn(e.set, ops, cell), self._fn(e.reset, ops, cell)
@@ -108,6 +112,11 @@ class Compiler:
             fn = scalar_fn(e.func)
             if len(args) == 1:
                 (a,) = args
+                if e.func == "abs":
+                    def absolute() -> Any:  # scalar_fn("abs") in one closure
+                        v = a()
+                        return abs(v) if type(v) is float and v == v else UNKNOWN
+                    return absolute
                 return lambda: fn(a())
             if len(args) == 2:
                 a, b = args
@@ -209,6 +218,18 @@ def _decided_chain(op: str, terms: Tuple[Fn, ...], parts: Sequence[ast.Expr], st
                 unknown = True
         return UNKNOWN if unknown else neutral
     return chain
+
+
+_KLEENE_OPS = frozenset(("<", "<=", ">", ">=", "==", "!=", "and", "or"))
+
+
+def _kleene(e: ast.Expr) -> bool:
+    """Whether e's closure only ever returns True, False or UNKNOWN (so as_bool would change nothing)."""
+    if isinstance(e, ast.Binary):
+        return e.op in _KLEENE_OPS
+    if isinstance(e, ast.Unary):
+        return e.op == "not"
+    return isinstance(e, (ast.RuleRef, ast.For, ast.Within, ast.Latch))
 
 
 _COMPARE = {"<": operator.lt, "<=": operator.le, ">": operator.gt, ">=": operator.ge}

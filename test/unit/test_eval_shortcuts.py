@@ -89,3 +89,33 @@ def test_a_comparison_with_a_number_is_the_operator_tables_comparison(op, const,
     assert fast is not None
     expected = BINARY[op](const, value) if const_left else BINARY[op](value, const)
     assert fast() is expected
+
+
+@settings(max_examples=200, deadline=None)
+@given(ANY_VALUE)
+def test_abs_is_the_operator_tables_abs(value):
+    from rubass.lang import ast
+    from rubass.lang.ops import scalar_fn
+
+    store = Store(0.0)
+    store.cell(("/t", ("data",)))[0] = value
+    fn = Compiler(store, {})._fn(ast.Call("abs", (ast.TopicRef("/t", ("data",)),)), [], None)
+    got, expected = fn(), scalar_fn("abs")(value)
+    assert got is expected or got == expected and type(got) is type(expected)
+
+
+def test_a_condition_is_true_false_or_unknown_without_as_bool_at_its_root():
+    spec = check_text("action primitive warn;\nentity e { rules: a: topic /a.data > 0; b: not (topic /b.data > 0);\n"
+                      "  c: (topic /a.data > 0) for 1 s; d: topic /f.data; }\nif (e.a) then { warn; }\n",
+                      os.path.join(ROOT, "x.rbs"), [LIB])
+    store = Store(0.0)
+    compiler = Compiler(store, {"warn": [False]})
+    fns = {r.key: compiler.compile(r.expr).fn for r in spec.rules}
+    for a, f in [(1.0, 1.0), (-1.0, math.nan), (UNKNOWN, 2.0), (math.inf, 0.0)]:
+        store.cell(("/a", ("data",)))[0] = a
+        store.cell(("/b", ("data",)))[0] = a
+        store.cell(("/f", ("data",)))[0] = f  # a number where a boolean field was expected: unknown
+        for key, fn in fns.items():
+            value = fn()
+            assert value is True or value is False or value is UNKNOWN, (key, a, value)
+        assert fns["e.d"]() is UNKNOWN
