@@ -166,6 +166,7 @@ class Engine:
         self._topic_plans = {t: self._plan([i for i, s in enumerate(topics_of) if t in s]) for t in spec.topics}
         self._node_plans = {n: self._plan([i for i, s in enumerate(nodes_of) if n in s]) for n in spec.nodes}
         self._tick_plan = self._plan(timed)
+        self._batch_plans: Dict[Tuple[str, ...], Tuple[int, ...]] = {}  # topics of a batch -> its plan
         self._all = tuple(range(len(self._nodes)))
 
     def _plan(self, seeds: Iterable[int]) -> Tuple[int, ...]:
@@ -200,12 +201,21 @@ class Engine:
                 self._run(plan, events, changed)
             events += self.advance(now)
             return events
-        seeds: Set[int] = set()
+        topics = []
         for topic, msg in items:
             self._store_message(topic, now, msg, changed)
-            seeds.update(self._topic_plans.get(topic, ()))
-        if seeds:
-            self._run(tuple(sorted(seeds)), events, changed)
+            topics.append(topic)
+        key = tuple(topics)
+        plan = self._batch_plans.get(key)
+        if plan is None:  # a recording repeats the same few batches of topics: planned once each
+            if len(self._batch_plans) >= 4096:
+                self._batch_plans.clear()
+            seeds: Set[int] = set()
+            for topic in key:
+                seeds.update(self._topic_plans.get(topic, ()))
+            plan = self._batch_plans[key] = tuple(sorted(seeds))
+        if plan:
+            self._run(plan, events, changed)
         events += self.advance(now)
         return events
 

@@ -84,6 +84,8 @@ def _walk(msg: Any, path: Tuple[PathElem, ...]) -> Tuple[Any, bool]:
 
 def convert(value: Any, path: Tuple[PathElem, ...] = ()) -> Any:
     """A message value as an engine value."""
+    if type(value) is float:  # the common case first
+        return value if value == value else UNKNOWN
     if value is True or value is False:
         return value
     if isinstance(value, (int, float)):
