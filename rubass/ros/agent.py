@@ -130,7 +130,8 @@ class Agent:
         return encode(self.name, self.host, self.addresses, now, self.period, self.seq, nodes)
 
     def close(self) -> None:
-        self._pool.shutdown(wait=False)
+        self._pool.shutdown(wait=True)  # the samples under way end within their timeouts
+        self.sampler._release()
 
 
 def main(argv: Optional[List[str]] = None) -> int:

@@ -42,10 +42,47 @@ def _schedstat_seconds(pid: int) -> Optional[float]:
     return total / 1e9
 
 
+def _fd_budget() -> int:
+    """How many /proc files the samplers may keep open: an eighth of the soft limit, at most 512,
+    so that many nodes of many threads never starve the monitor of sockets (EMFILE)."""
+    try:
+        import resource
+
+        soft = resource.getrlimit(resource.RLIMIT_NOFILE)[0]
+        if soft == resource.RLIM_INFINITY:
+            soft = 65536
+    except (ImportError, ValueError, OSError):
+        soft = 1024
+    return max(0, min(512, soft // 8))
+
+
+class _KeptFiles:
+    """The budget of kept /proc files, shared by every RunTime of the process."""
+
+    def __init__(self, budget: int) -> None:
+        self.budget, self.held = budget, 0
+        self.lock = threading.Lock()
+
+    def take(self) -> bool:
+        with self.lock:
+            if self.held >= self.budget:
+                return False
+            self.held += 1
+            return True
+
+    def give_back(self) -> None:
+        with self.lock:
+            self.held -= 1
+
+
+KEPT_FILES = _KeptFiles(_fd_budget())
+
+
 class RunTime:
     """`_schedstat_seconds` of one process, with each thread's file kept open and read again
     with pread: a sample costs a directory listing and a read per thread, not an open too
-    (about 6x less CPU for a rospy node's threads)."""
+    (about 6x less CPU for a rospy node's threads). Beyond the process's budget of kept files
+    (KEPT_FILES), a thread's file is opened, read and closed at each sample, as before."""
 
     def __init__(self, pid: int) -> None:
         self.pid = pid
@@ -62,7 +99,16 @@ class RunTime:
             fd = self._fds.get(tid)
             try:
                 if fd is None:
-                    fd = self._fds[tid] = os.open(f"/proc/{self.pid}/task/{tid}/schedstat", os.O_RDONLY)
+                    path = f"/proc/{self.pid}/task/{tid}/schedstat"
+                    if not KEPT_FILES.take():
+                        with open(path, "rb") as fh:
+                            total += int(fh.read().split()[0])
+                        continue
+                    try:
+                        fd = self._fds[tid] = os.open(path, os.O_RDONLY)
+                    except OSError:
+                        KEPT_FILES.give_back()
+                        raise
                 total += int(os.pread(fd, 128, 0).split()[0])
             except (OSError, ValueError, IndexError):
                 self._drop(tid)  # a thread that just exited
@@ -79,6 +125,7 @@ class RunTime:
         fd = self._fds.pop(tid, None)
         if fd is not None:
             os.close(fd)
+            KEPT_FILES.give_back()
 
 
 @dataclass
@@ -120,8 +167,8 @@ class NodeSampler:
         self._thread: Optional[threading.Thread] = None
         self._pool = concurrent.futures.ThreadPoolExecutor(max_workers=max(1, min(8, len(nodes))),
                                                            thread_name_prefix="rubass-node")
-        self._callers: Dict[str, rpc.Caller] = {}  # kept connections, by URI
-        self._callers_lock = threading.Lock()
+        self._masters: Dict[int, rpc.Caller] = {}  # a kept connection to the master per sampling thread
+        self._masters_lock = threading.Lock()
 
     def start(self) -> None:
         if self.status:
@@ -138,26 +185,22 @@ class NodeSampler:
 
     def _release(self) -> None:
         """Close the kept connections and /proc files (no sample is running)."""
-        with self._callers_lock:
-            callers, self._callers = list(self._callers.values()), {}
+        with self._masters_lock:
+            callers, self._masters = list(self._masters.values()), {}
         for caller in callers:
             caller.close()
         for pid in list(self._run_times):
             self._forget_process(pid)
 
-    def _caller(self, uri: str, timeout: float) -> rpc.Caller:
-        """The kept connection to a URI (the master's, or a node's)."""
-        with self._callers_lock:
-            caller = self._callers.get(uri)
-            if caller is None:
-                caller = self._callers[uri] = rpc.Caller(uri, timeout)
+    def _master(self) -> rpc.Caller:
+        """This thread's kept connection to the master: one per sampling thread, so that a slow
+        master delays each sample by its own timeout, not by the others' too."""
+        ident = threading.get_ident()
+        with self._masters_lock:
+            caller = self._masters.get(ident)
+            if caller is None or caller.uri != self.master_uri:
+                caller = self._masters[ident] = rpc.Caller(self.master_uri, max(self.timeout, 0.5))
             return caller
-
-    def _forget_caller(self, uri: str) -> None:
-        with self._callers_lock:
-            caller = self._callers.pop(uri, None)
-        if caller is not None:
-            caller.close()
 
     def _run(self) -> None:
         next_at = time.monotonic()
@@ -197,7 +240,9 @@ class NodeSampler:
         """The pid of the process answering at a node's URI, or None and why not (a hung node
         is found by the timeout: its kernel still accepts the connection)."""
         try:
-            code, msg, pid = self._caller(uri, self.timeout).call("getPid", self.caller_id)
+            # a connection of its own each time: a node that shut down closes its listening socket
+            # (refused), though its threads may still serve a connection it had accepted
+            code, msg, pid = rpc.Caller(uri, self.timeout, keep_alive=False).call("getPid", self.caller_id)
         except socket.timeout:
             return None, f"did not answer getPid within {self.timeout * 1000:.0f} ms (hung?)"
         except (OSError, xmlrpc.client.Error, ValueError) as exc:
@@ -213,23 +258,23 @@ class NodeSampler:
         name = st.resolved
         uri = self._uris.get(name)
         if uri is not None and time.monotonic() - self._looked_up.get(name, -math.inf) < self.LOOKUP_PERIOD:
-            pid, _ = self._pid_at(uri)
+            pid, why = self._pid_at(uri)
             if pid is not None and pid == self._pids.get(name):
                 return True, pid, "alive"
+            return self._ask_master(st, (uri, pid, why))
         return self._ask_master(st)
 
-    def _ask_master(self, st: NodeStatus) -> Tuple[Any, Optional[int], str]:
+    def _ask_master(self, st: NodeStatus, tried: Optional[Tuple[str, Optional[int], str]] = None
+                    ) -> Tuple[Any, Optional[int], str]:
+        """`tried`: the node's answer at a URI in this sample already (not asked twice: a hung
+        node reads dead after one timeout, not two)."""
         name = st.resolved
         note = ""
         try:  # the master with a timeout too: a hung master must not stall every sample
-            code, msg, uri = self._caller(self.master_uri, max(self.timeout, 0.5)).call("lookupNode", self.caller_id,
-                                                                                        name)
+            code, msg, uri = self._master().call("lookupNode", self.caller_id, name)
         except (OSError, socket.error, xmlrpc.client.Error, ValueError) as exc:
             code, msg, uri = -2, str(exc), None
         if code == 1:
-            old = self._uris.get(name)
-            if old is not None and old != uri:
-                self._forget_caller(old)  # the node restarted elsewhere: its old address is gone
             self._uris[name] = uri
             self._looked_up[name] = time.monotonic()
         else:
@@ -241,7 +286,7 @@ class NodeSampler:
             # the master is down, or restarted and does not know the node (rospy nodes do not
             # re-register): ask the node where it was; alive only if it is the same process
             note = " (the master cannot be reached)" if code == -2 else " (not registered with the master: restarted?)"
-        pid, why = self._pid_at(uri)
+        pid, why = tried[1:] if tried is not None and tried[0] == uri else self._pid_at(uri)
         if pid is None:
             return False, None, why
         known = self._pids.get(name)

@@ -35,26 +35,32 @@ def proxy(uri: str, timeout: float) -> xmlrpc.client.ServerProxy:
 
 
 class Caller:
-    """XML-RPC calls to one URI over a kept-alive connection; each call gives up after `timeout`
-    seconds in all (socket.timeout). Errors are those of `proxy`: OSError for the connection,
-    xmlrpc.client.Error (ProtocolError, ResponseError, Fault) for a bad answer. Thread-safe."""
+    """XML-RPC calls to one URI; each call gives up after `timeout` seconds in all, counted from
+    when the call gets the connection (socket.timeout). Errors are those of `proxy`: OSError for
+    the connection, xmlrpc.client.Error (ProtocolError, ResponseError, Fault) for a bad answer.
+    Thread-safe (one call at a time).
 
-    def __init__(self, uri: str, timeout: float) -> None:
+    keep_alive: one connection for every call (the master). Without it each call connects anew
+    and asks the server to close (a node's liveness: a node that shut down closes its listening
+    socket, but a connection it had accepted may still be served by its threads)."""
+
+    def __init__(self, uri: str, timeout: float, keep_alive: bool = True) -> None:
         parsed = urlparse(uri)
         if parsed.scheme != "http" or not parsed.hostname:
             raise ValueError(f"not an http XML-RPC URI: {uri!r}")
-        self.uri, self.timeout = uri, timeout
+        self.uri, self.timeout, self.keep_alive = uri, timeout, keep_alive
         self._addr = (parsed.hostname, parsed.port or 80)
         self._head = (f"POST {parsed.path or '/'} HTTP/1.1\r\nHost: {parsed.hostname}:{self._addr[1]}\r\n"
-                      f"Content-Type: text/xml\r\nContent-Length: ")
+                      + ("" if keep_alive else "Connection: close\r\n")
+                      + "Content-Type: text/xml\r\nContent-Length: ")
         self._sock: Optional[socket.socket] = None
         self._lock = threading.Lock()
 
     def call(self, method: str, *params: Any) -> Any:
         body = xmlrpc.client.dumps(params, method).encode()
         request = f"{self._head}{len(body)}\r\n\r\n".encode() + body
-        deadline = time.monotonic() + self.timeout
         with self._lock:
+            deadline = time.monotonic() + self.timeout
             try:
                 try:
                     kept = self._sock is not None
@@ -89,7 +95,10 @@ class Caller:
         sock = self._sock
         try:
             sock.settimeout(_left(deadline))
-            sock.sendall(request)
+            try:
+                sock.sendall(request)
+            except (ConnectionResetError, BrokenPipeError, ConnectionAbortedError):
+                raise _Stale() from None  # a kept connection the server had dropped
             status, close, length, buf = self._head_of_answer(sock, deadline)
             if length is None:  # no length: the body runs to the end of the connection
                 close = True
@@ -108,7 +117,7 @@ class Caller:
         except _Stale:
             self.close()
             raise
-        if close:
+        if close or not self.keep_alive:
             self.close()
         if status != 200:
             raise xmlrpc.client.ProtocolError(self.uri, status, f"HTTP status {status}", {})
@@ -118,7 +127,12 @@ class Caller:
         """(status, whether the server closes, Content-Length or None, the body bytes read so far)."""
         buf = b""
         while b"\r\n\r\n" not in buf:
-            chunk = self._recv(sock, deadline)
+            try:
+                chunk = self._recv(sock, deadline)
+            except (ConnectionResetError, ConnectionAbortedError):
+                if buf:
+                    raise
+                raise _Stale() from None  # reset before a word of answer: dropped while idle
             if not chunk:
                 if not buf:
                     raise _Stale()

@@ -53,10 +53,12 @@ class _FakeCaller:
         pass
 
 
-def _fake_sampler(answers, calls):
+def _fake_sampler(answers, calls, monkeypatch):
+    from rubass.ros import nodes
+
+    monkeypatch.setattr(nodes.rpc, "Caller", lambda uri, timeout, keep_alive=True: _FakeCaller(answers, calls, uri))
     sampler = NodeSampler([("driver", "/driver")], lambda *a: None, lambda: 1.0, 0.1, "/rubass")
     sampler.master_uri = "http://master:11311/"
-    sampler._caller = lambda uri, timeout: _FakeCaller(answers, calls, uri)
     sampler._is_local = lambda host: False
     return sampler
 
@@ -65,10 +67,10 @@ def test_a_node_is_asked_at_its_uri_and_the_master_where_it_is_at_most_once_a_se
     import time
 
     calls, clock = [], [100.0]
-    monkeypatch.setattr(time, "monotonic", lambda: clock[0])
     answers = {("http://master:11311/", "lookupNode"): [1, "", "http://pc:4000/"],
                ("http://pc:4000/", "getPid"): [1, "", 77]}
-    sampler = _fake_sampler(answers, calls)
+    sampler = _fake_sampler(answers, calls, monkeypatch)
+    monkeypatch.setattr(time, "monotonic", lambda: clock[0])
     st = NodeStatus("driver", "/driver")
     for _ in range(10):  # a second of samples at 10 Hz
         sampler.sample(st)
@@ -85,7 +87,7 @@ def test_a_node_that_stops_answering_at_its_uri_is_looked_up_again_in_the_same_s
     calls = []
     answers = {("http://master:11311/", "lookupNode"): [1, "", "http://pc:4000/"],
                ("http://pc:4000/", "getPid"): [1, "", 77]}
-    sampler = _fake_sampler(answers, calls)
+    sampler = _fake_sampler(answers, calls, monkeypatch)
     st = NodeStatus("driver", "/driver")
     sampler.sample(st)
     # the node restarted elsewhere: the old URI refuses, the master knows the new one
@@ -107,13 +109,86 @@ def test_another_process_answering_at_the_uri_is_checked_with_the_master(monkeyp
     calls = []
     answers = {("http://master:11311/", "lookupNode"): [1, "", "http://pc:4000/"],
                ("http://pc:4000/", "getPid"): [1, "", 77]}
-    sampler = _fake_sampler(answers, calls)
+    sampler = _fake_sampler(answers, calls, monkeypatch)
     st = NodeStatus("driver", "/driver")
     sampler.sample(st)
     answers[("http://pc:4000/", "getPid")] = [1, "", 99]  # the port reused by another process
     answers[("http://master:11311/", "lookupNode")] = [-1, "unknown node", ""]  # the node is gone
     sampler.sample(st)
     assert st.alive is False and "another process (pid 99)" in st.why
+
+
+def test_a_hung_node_reads_dead_after_one_timeout_not_two(monkeypatch):
+    import socket
+
+    calls = []
+    answers = {("http://master:11311/", "lookupNode"): [1, "", "http://pc:4000/"],
+               ("http://pc:4000/", "getPid"): [1, "", 77]}
+    sampler = _fake_sampler(answers, calls, monkeypatch)
+    st = NodeStatus("driver", "/driver")
+    sampler.sample(st)
+    answers[("http://pc:4000/", "getPid")] = socket.timeout("timed out")  # SIGSTOPped
+    calls.clear()
+    sampler.sample(st)
+    assert st.alive is False and "did not answer getPid within 100 ms" in st.why
+    assert calls == [("http://pc:4000/", "getPid"), ("http://master:11311/", "lookupNode")]
+
+
+def test_every_getpid_is_asked_on_a_connection_of_its_own():
+    # a node that shut down closes its listening socket, but a connection it had accepted may
+    # still be answered by its threads: liveness must never ride on a kept connection
+    import threading
+    from xmlrpc.server import SimpleXMLRPCRequestHandler, SimpleXMLRPCServer
+
+    class Http11(SimpleXMLRPCRequestHandler):
+        protocol_version = "HTTP/1.1"
+
+    accepted = []
+
+    class Server(SimpleXMLRPCServer):
+        def process_request(self, request, client_address):
+            accepted.append(client_address)
+            super().process_request(request, client_address)
+
+    srv = Server(("127.0.0.1", 0), Http11, logRequests=False)
+    srv.register_function(lambda caller: [1, "", 4242], "getPid")
+    thread = threading.Thread(target=srv.serve_forever, kwargs={"poll_interval": 0.05}, daemon=True)
+    thread.start()
+    try:
+        sampler = NodeSampler([("n", "/n")], lambda *a: None, lambda: 1.0, 0.1, "/rubass")
+        uri = f"http://127.0.0.1:{srv.server_address[1]}/"
+        assert [sampler._pid_at(uri) for _ in range(3)] == [(4242, "")] * 3
+        assert len(accepted) == 3
+    finally:
+        srv.shutdown()
+        srv.server_close()
+
+
+def test_run_times_keep_their_proc_files_within_the_budget_and_close_them(monkeypatch):
+    import os
+    import threading
+
+    from rubass.ros import nodes
+
+    stop = threading.Event()
+    workers = [threading.Thread(target=stop.wait) for _ in range(6)]  # this process: 7+ threads
+    for w in workers:
+        w.start()
+    try:
+        monkeypatch.setattr(nodes, "KEPT_FILES", nodes._KeptFiles(3))
+        before = len(os.listdir("/proc/self/fd"))
+        reader = nodes.RunTime(os.getpid())
+        first = reader.seconds()
+        assert nodes.KEPT_FILES.held == 3 and len(os.listdir("/proc/self/fd")) == before + 3
+        second = reader.seconds()  # the kept files read again, the others opened and closed
+        assert second >= first > 0
+        assert abs(second - nodes._schedstat_seconds(os.getpid())) < 0.05
+        reader.close()
+        assert nodes.KEPT_FILES.held == 0 and len(os.listdir("/proc/self/fd")) == before
+    finally:
+        stop.set()
+        for w in workers:
+            w.join()
 
 
 def test_cpu_of_a_busy_process_is_not_quantized_to_ten_percent_steps():

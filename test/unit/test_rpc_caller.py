@@ -169,3 +169,41 @@ def test_a_refused_connection_is_an_oserror():
 def test_a_uri_that_is_not_http_is_refused_at_once():
     with pytest.raises(ValueError):
         Caller("rosrpc://host:1", 0.5)
+
+
+def test_without_keep_alive_every_call_has_a_connection_of_its_own(server):
+    srv, _ = server
+    caller = Caller(f"http://127.0.0.1:{srv.server_address[1]}/", 1.0, keep_alive=False)
+    for _ in range(5):
+        assert caller.call("getPid", "/me") == [1, "", 4242]
+        assert caller._sock is None
+    assert srv.connections == 5
+
+
+def test_a_kept_connection_reset_while_idle_is_reopened_once():
+    import struct
+
+    sock = _listener()
+    body = xmlrpc.client.dumps(([1, "", 7],), methodresponse=True).encode()
+    answer = b"HTTP/1.1 200 OK\r\nContent-Length: %d\r\n\r\n" % len(body) + body
+
+    def serve():
+        first, _ = sock.accept()
+        first.recv(65536)
+        first.sendall(answer)
+        time.sleep(0.1)
+        first.setsockopt(socket.SOL_SOCKET, socket.SO_LINGER, struct.pack("ii", 1, 0))
+        first.close()  # a reset (RST), as from a host that lost the connection
+        second, _ = sock.accept()
+        second.recv(65536)
+        second.sendall(answer)
+        second.close()
+
+    threading.Thread(target=serve, daemon=True).start()
+    try:
+        caller = Caller(f"http://127.0.0.1:{sock.getsockname()[1]}/", 1.0)
+        assert caller.call("getPid", "/me") == [1, "", 7]
+        time.sleep(0.3)
+        assert caller.call("getPid", "/me") == [1, "", 7]
+    finally:
+        sock.close()
