@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import heapq
 import itertools
+import math
 from dataclasses import dataclass
 from typing import AbstractSet, Any, Dict, FrozenSet, Iterable, List, Optional, Set, Tuple
 
@@ -19,6 +20,7 @@ from ..lang.model import CheckedBehaviour, CheckedSpec
 from .evaluate import Compiled, Compiler
 from .explain import Explainer, Witness
 from .fields import FieldError, extract
+from .operators import ForOp, LatchOp, WithinOp
 from .store import Store
 from .values import UNKNOWN
 
@@ -42,7 +44,7 @@ class _Node:
     """One rule or behaviour of the evaluation graph."""
 
     __slots__ = ("key", "compiled", "behaviour", "active", "value", "actions", "users", "pushed",
-                 "volatile", "slots", "inputs", "fresh")
+                 "volatile", "slots", "inputs", "fresh", "due")
 
     def __init__(self, key: str, compiled: Compiled, behaviour: Optional[CheckedBehaviour]) -> None:
         self.key, self.compiled, self.behaviour = key, compiled, behaviour
@@ -53,13 +55,15 @@ class _Node:
         self.pushed: Dict[int, float] = {}  # id(op) -> the deadline already in the heap
         # Incremental evaluation after a message: a node that is not `volatile` is a function of
         # the fields it reads (`slots`) and of the values of other nodes (`inputs`) alone, so it
-        # is skipped when none of those changed. Volatile: stateful operators (for, within,
-        # latch, crossings: each evaluation counts), time (age, frequency, stamp_age, rate),
-        # node samples, active(), laser limits.
+        # is skipped when none of those changed. `for`, `within` and `latch` keep it so: with
+        # the same operand they give the same value until their deadline, when the engine
+        # evaluates the node (`fresh`). Volatile: crossings of time, age, frequency,
+        # stamp_age, rate, node samples, active(), laser limits.
         self.volatile = True
         self.slots: FrozenSet[Any] = frozenset()  # field slots while planning, then their numbers
         self.inputs: FrozenSet[int] = frozenset()
-        self.fresh = True  # never evaluated yet
+        self.fresh = True  # never evaluated yet, or its operator's deadline came (evaluated whatever changed)
+        self.due = math.inf  # the earliest deadline of its operators: from then on it is not skipped
 
     @property
     def checked(self) -> Optional[CheckedBehaviour]:
@@ -114,7 +118,10 @@ class Engine:
             expr = node.behaviour.cond if node.behaviour else spec.rule(node.key).expr
             topics, nodes = set(), set()
             slots: Set[Tuple[str, Tuple[ast.PathElem, ...]]] = set()
-            volatile = bool(node.compiled.ops)
+            # `for`, `within` and `latch` give the same value again for the same operand
+            # until their own deadline (where the node is evaluated whatever changed): they
+            # do not make a node volatile; a crossing of time does (its value moves with now)
+            volatile = any(not isinstance(op, _INSTANT_OPS) for op in node.compiled.ops)
             is_timed = False
             for e in ast.walk(expr):
                 if isinstance(e, ast.TopicRef):
@@ -290,6 +297,7 @@ class Engine:
                 break
             _, _, idx, _ = heapq.heappop(self._heap)
             self.store.now = max(self.store.now, due)
+            self._nodes[idx].fresh = True  # its operator's instant: evaluated whatever else changed
             self._run(self._plan((idx,)), events, _NO_FIELDS)
         self.store.now = max(self.store.now, now)
         return events
@@ -465,22 +473,26 @@ class Engine:
         value: it would give the value it has. With `changed` None, every node is evaluated."""
         store, nodes, rules = self.store, self._nodes, self.store.rules
         moved: Set[int] = set()  # nodes whose value changed in this run
-        incremental = changed is not None
+        incremental, now = changed is not None, store.now
         for i in plan:
             node = nodes[i]
-            if incremental and not node.volatile and not node.fresh \
+            if incremental and not node.volatile and not node.fresh and node.due > now \
                     and changed.isdisjoint(node.slots) and moved.isdisjoint(node.inputs):  # type: ignore[union-attr]
                 continue
             node.fresh = False
             compiled = node.compiled
             value = compiled.fn()
             if compiled.ops:  # _schedule, inline: the deadlines its operators announce now
-                pushed = node.pushed
+                pushed, first = node.pushed, math.inf
                 for op in compiled.ops:
                     due = op.deadline()
-                    if due is not None and pushed.get(id(op)) != due:
-                        pushed[id(op)] = due
-                        heapq.heappush(self._heap, (due, next(self._seq), i, op))
+                    if due is not None:
+                        if due < first:
+                            first = due
+                        if pushed.get(id(op)) != due:
+                            pushed[id(op)] = due
+                            heapq.heappush(self._heap, (due, next(self._seq), i, op))
+                node.due = first
             b = node.behaviour
             if b is None:
                 key = node.key
@@ -507,6 +519,7 @@ class Engine:
                 events.append(self._event(node, "release"))
 
     def _schedule(self, idx: int, node: _Node) -> None:
+        node.due = min((due for due, _ in node.compiled.deadlines()), default=math.inf)
         for due, op in node.compiled.deadlines():
             if node.pushed.get(id(op)) != due:
                 node.pushed[id(op)] = due
@@ -515,6 +528,7 @@ class Engine:
 
 STAMP: Tuple[ast.PathElem, ...] = ("header", "stamp")
 _ABSENT = object()  # a rule not evaluated yet
+_INSTANT_OPS = (ForOp, WithinOp, LatchOp)  # operators whose value moves only at inputs and deadlines
 _NO_FIELDS: FrozenSet[int] = frozenset()  # a tick, a deadline, a node sample: no field changed
 
 
