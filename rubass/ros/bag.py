@@ -50,6 +50,9 @@ def open_bag(path: str) -> Tuple[Bag, BagInfo]:
         raise BagError(f"{path}: not a readable ROS 1 bag ({exc})") from None
     except OSError as exc:
         raise BagError(f"{path}: not a readable ROS 1 bag ({exc.__class__.__name__}: {exc})") from None
+    except MemoryError:
+        raise BagError(f"{path}: not a readable ROS 1 bag (a record claims more memory than there is: "
+                       f"corrupt?)") from None
     topics = bag.topics()
     return bag, BagInfo(path, bag.start_time, bag.end_time, bag.message_count, {t: v[0] for t, v in topics.items()})
 
@@ -101,6 +104,8 @@ def read(bag: Bag, topics: List[str], decode: Set[str]) -> Iterator[Tuple[float,
             raise BagError(f"{bag.filename}: the bag is corrupt: {exc}") from None
         except OSError as exc:
             raise BagError(f"{bag.filename}: the bag cannot be read ({exc.__class__.__name__}: {exc})") from None
+        except MemoryError:
+            raise BagError(f"{bag.filename}: the bag is corrupt: a chunk claims more memory than there is") from None
         return
     yield from _read_rosbag(bag, topics, decode)
 

@@ -109,7 +109,10 @@ class BagFile:
         head = self._file.read(4)
         if len(head) < 4:
             raise BagFormatError(f"the chunk at byte {chunk.pos} is cut short")
-        head += self._file.read(U32.unpack(head)[0] + 4)
+        length = U32.unpack(head)[0]
+        if chunk.pos + 4 + length + 4 > size:  # before reading: a corrupt length must not allocate gigabytes
+            raise BagFormatError(f"the chunk at byte {chunk.pos} has a header longer than the file")
+        head += self._file.read(length + 4)
         fields, data_pos = self._header_only(head, chunk)
         if op_of(fields) != OP_CHUNK:
             raise BagFormatError(f"no chunk at byte {chunk.pos}, where the index says one is")

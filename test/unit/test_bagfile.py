@@ -233,6 +233,20 @@ def test_corrupt_chunks_give_bag_errors(tmp_path):
         assert error is not None and error.startswith(path + ": the bag is corrupt"), error
 
 
+def test_a_chunk_header_length_beyond_the_file_is_refused_before_it_is_read(tmp_path):
+    import struct
+
+    path = write_bag(str(tmp_path / "h.bag"), float_items(50))
+    with BagFile(path) as b:
+        chunk = b.chunks[0]
+    data = bytearray(open(path, "rb").read())
+    data[chunk.pos:chunk.pos + 4] = struct.pack("<I", 0xFFFFFFF0)  # a header of almost 4 GB
+    with open(path, "wb") as fh:
+        fh.write(data)
+    with pytest.raises(BagError, match="not a readable ROS 1 bag.*header longer than the file"):
+        open_bag(path)
+
+
 def test_unindexed_bag_says_reindex(tmp_path):
     path = write_bag(str(tmp_path / "u.bag"), float_items(10))
     data = bytearray(open(path, "rb").read())
