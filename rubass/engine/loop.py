@@ -10,7 +10,6 @@ import dataclasses
 import math
 import queue
 import threading
-import time
 from dataclasses import dataclass
 from typing import Any, Callable, Dict, List, Optional, Tuple
 
@@ -56,9 +55,6 @@ class EngineLoop:
     the order inputs were queued. `on_error` gets what an input handled inline raised.
     """
 
-    SPIN = 0.0015  # s before a deadline that the engine's thread stops sleeping and yields instead
-    SPIN_SHARE = 0.02  # at most this share of the time spent so
-    SPIN_BURST = 4
     BURST = 256  # inputs one submitting thread handles before it leaves the rest to the engine's thread
 
     def __init__(self, engine: Engine, clock: Callable[[], float], rate: float, handler: Handler,
@@ -68,8 +64,6 @@ class EngineLoop:
         self.engine = engine
         self.clock = clock
         self.period = 1.0 / rate
-        self._at_deadline = False  # whether the current wait ends at a deadline (not a tick)
-        self._spin_tokens, self._spin_refilled = self.SPIN * self.SPIN_BURST, time.monotonic()
         self.handler = handler
         self.tick_hook = tick_hook
         self.inbox: "queue.Queue[Any]" = queue.Queue(maxsize=max_queue)
@@ -215,10 +209,7 @@ class EngineLoop:
                 timeout = self._wait_for(max_wait)
                 self._sleep_until = self._last_clock + timeout
             if timeout > 0 and not self.inbox.queue and not self._newest:
-                spin = self._spin_for(timeout)
-                target = time.monotonic() + timeout
-                if not self._wake.wait(timeout - spin) and spin:
-                    _spin_until(target, self._wake.is_set)
+                self._wake.wait(timeout)
             self._wake.clear()
             with self._engine_lock:
                 self._sleep_until = -math.inf  # awake: a submitting thread need not wake it
@@ -226,18 +217,10 @@ class EngineLoop:
                 self._due()
             return
         timeout = self._wait_for(max_wait)
-        spin = self._spin_for(timeout)
-        target = time.monotonic() + timeout
         try:
-            item = self.inbox.get(timeout=timeout - spin) if timeout > 0 else self.inbox.get_nowait()
+            item = self.inbox.get(timeout=timeout) if timeout > 0 else self.inbox.get_nowait()
         except queue.Empty:
             item = None
-            if spin:
-                _spin_until(target, lambda: bool(self.inbox.queue))
-                try:
-                    item = self.inbox.get_nowait()
-                except queue.Empty:
-                    pass
         if item is not None:
             self._handle(item)
         if self._newest:
@@ -256,30 +239,12 @@ class EngineLoop:
             self._next_tick = now + self.period
         wake = self._next_tick
         deadline = self.engine.next_deadline()
-        self._at_deadline = deadline is not None and deadline < wake
-        if self._at_deadline:
-            wake = deadline  # type: ignore[assignment]
+        if deadline is not None and deadline < wake:
+            wake = deadline
         timeout = max(0.0, wake - now)
-        if max_wait is not None and max_wait < timeout:
-            timeout, self._at_deadline = max_wait, False
+        if max_wait is not None:
+            timeout = min(timeout, max_wait)
         return timeout
-
-    def _spin_for(self, timeout: float) -> float:
-        """How much of a wait that ends at a deadline is spent yielding rather than asleep: the
-        OS wakes a sleeping thread 0.1-1 ms late on a loaded or virtual machine, which would be
-        the error of every `for`. Deadlines are mostly rare (a `for` completing), but a crossing
-        of time can be the next wake-up again and again (`age(t) > 10 ms` at 100 Hz): a budget
-        keeps the yielding under SPIN_SHARE of the time, in bursts of at most SPIN_BURST waits."""
-        if not (self._at_deadline and timeout > self.SPIN):
-            return 0.0
-        now = time.monotonic()
-        self._spin_tokens = min(self.SPIN * self.SPIN_BURST,
-                                self._spin_tokens + (now - self._spin_refilled) * self.SPIN_SHARE)
-        self._spin_refilled = now
-        if self._spin_tokens < self.SPIN:
-            return 0.0
-        self._spin_tokens -= self.SPIN
-        return self.SPIN
 
     def _drain(self, limit: Optional[int]) -> int:
         """Handle up to `limit` queued inputs (all, if None) in queue order, then the conflated newest."""
@@ -353,15 +318,3 @@ class EngineLoop:
     def _emit(self, events: List[Event], cause: Any) -> None:
         if events:
             self.handler(events, cause)
-
-
-def _spin_until(target: float, woken: Callable[[], bool]) -> None:
-    """Until time.monotonic() reaches target or woken(): yielding the processor (time.sleep(0),
-    which lets the other threads run: 10-60 µs a turn here), then, for the last 0.2 ms, a
-    busy loop, so that the deadline is met to a few µs."""
-    while not woken():
-        left = target - time.monotonic()
-        if left <= 0:
-            return
-        if left > 0.0002:
-            time.sleep(0)
