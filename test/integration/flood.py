@@ -1,7 +1,7 @@
 #!/usr/bin/python3
 """Floods a topic for the fault tests, then sends one violation and times the monitor's stop.
 
-    flood.py burst N        N std_msgs/Float64 on /x (data 0) as fast as rospy publishes them
+    flood.py burst N        N std_msgs/Float64 on /x (data 0 and 0.5 in turn) as fast as rospy publishes them
     flood.py huge N SIZE    N std_msgs/Float64MultiArray on /cloud of SIZE float64 each, 10 per s
 
 then one violation (/x data 5, or a /cloud whose max is 9) and a wait for /safety_cmd.
@@ -31,9 +31,9 @@ def main():
     time.sleep(0.5)
     t0 = time.time()
     if mode == "burst":
-        msg = Float64(0.0)
-        for _ in range(n):
-            pub.publish(msg)
+        msgs = (Float64(0.0), Float64(0.5))  # harmless values that change: every rule reading /x is evaluated
+        for i in range(n):
+            pub.publish(msgs[i % 2])
         violation = Float64(5.0)
     else:
         size = int(sys.argv[3])
