@@ -519,8 +519,9 @@ class Engine:
                 events.append(self._event(node, "release"))
 
     def _schedule(self, idx: int, node: _Node) -> None:
-        node.due = min((due for due, _ in node.compiled.deadlines()), default=math.inf)
-        for due, op in node.compiled.deadlines():
+        deadlines = node.compiled.deadlines()
+        node.due = min((due for due, _ in deadlines), default=math.inf)
+        for due, op in deadlines:
             if node.pushed.get(id(op)) != due:
                 node.pushed[id(op)] = due
                 heapq.heappush(self._heap, (due, next(self._seq), idx, op))

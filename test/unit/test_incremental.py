@@ -54,6 +54,13 @@ def _feed(engine, seq):
     return [(e.time, e.kind, e.behaviour, e.rule, e.value) for e in out]
 
 
+def _assert_same_as_full_evaluation(spec, seq):
+    inc, full = Engine(spec, 0.0), FullEngine(spec, 0.0)
+    assert _feed(inc, [(0.0, None, None)] + seq) == _feed(full, [(0.0, None, None)] + seq)
+    assert inc.store.rules == full.store.rules
+    assert inc.active_behaviours() == full.active_behaviours()
+
+
 def test_incremental_evaluation_gives_the_events_of_full_evaluation():
     rnd = random.Random(17)
     spec = check_text(SPEC, os.path.join(ROOT, "x.rbs"), [LIB])
@@ -72,10 +79,7 @@ def test_incremental_evaluation_gives_the_events_of_full_evaluation():
                 seq.append((t, "/s", {"r": tuple(rnd.choice([0.5, 1.5, 3.0]) for _ in range(rnd.choice([2, 4])))}))
             else:
                 seq.append((t, None, None))
-        inc, full = Engine(spec, 0.0), FullEngine(spec, 0.0)
-        assert _feed(inc, [(0.0, None, None)] + seq) == _feed(full, [(0.0, None, None)] + seq)
-        assert inc.store.rules == full.store.rules
-        assert inc.active_behaviours() == full.active_behaviours()
+        _assert_same_as_full_evaluation(spec, seq)
 
 
 def test_a_message_that_changes_nothing_skips_its_nodes_until_an_operators_deadline():
@@ -128,7 +132,4 @@ def test_operators_over_rules_and_in_behaviours_give_the_events_of_full_evaluati
                 seq.append((t, "/y", {"v": rnd.choice([-1, 1, 1, 1])}))
             else:
                 seq.append((t, None, None))
-        inc, full = Engine(spec, 0.0), FullEngine(spec, 0.0)
-        assert _feed(inc, [(0.0, None, None)] + seq) == _feed(full, [(0.0, None, None)] + seq)
-        assert inc.store.rules == full.store.rules
-        assert inc.active_behaviours() == full.active_behaviours()
+        _assert_same_as_full_evaluation(spec, seq)
