@@ -19,6 +19,8 @@ import threading
 from dataclasses import dataclass
 from typing import Any, Dict, Iterable, List, Optional, Sequence, Tuple
 
+from ..lang.sourcefile import read_at_most
+
 FORMAT = "rubass-latches"
 VERSION = 1
 
@@ -45,7 +47,7 @@ def load(path: str, declared: Dict[str, bool]) -> Tuple[List[Latch], List[str]]:
     """
     try:
         with open(path, "rb") as fh:
-            raw = fh.read(1 << 20)
+            raw = read_at_most(fh, 1 << 20)
     except FileNotFoundError:
         return [], []
     except OSError as exc:

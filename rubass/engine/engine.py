@@ -85,7 +85,9 @@ class Engine:
         self._active: Dict[str, List[bool]] = {a: [False] for a in spec.actions}
         self._holders: Dict[str, Set[str]] = {}
         self._compiler = Compiler(self.store, self._active)
-        self._explainer = Explainer(spec, self.store, lambda e: self._compiler._fn(e, [], None))
+        compiler = self._compiler  # not self in the lambda: an engine that refers to itself is freed
+        # only by the cyclic garbage collector, so each one a reload replaced would linger until then
+        self._explainer = Explainer(spec, self.store, lambda e: compiler._fn(e, [], None))
         self._explainer.prepare()  # a start then only reads values (it is computed before dispatch)
         order = spec.evaluation or [r.key for r in spec.rules] + [f"b:{b.index}" for b in spec.behaviours]
         rules = {r.key: r for r in spec.rules}

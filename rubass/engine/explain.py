@@ -190,19 +190,14 @@ def _terms(expr: ast.Expr) -> Sequence[ast.Expr]:
     """Readings in reading order; a function's own topic argument is not read separately,
     nor is a whole array (its min/max/len is)."""
     out: List[ast.Expr] = []
-
-    def visit(e: ast.Expr) -> None:
+    todo = [expr]  # a stack, not a recursive closure: a closure that calls itself is a reference
+    while todo:    # cycle, and the engine it serves would wait for the cyclic collector
+        e = todo.pop()
         if _checked_label(e) is not None:
             out.append(e)
-            return
-        if isinstance(e, ast.Quant):
-            return  # its body reads one element at a time: no single value to show
-        if isinstance(e, ast.TopicRef):
+        elif isinstance(e, ast.TopicRef):
             if e.path:
                 out.append(e)
-            return
-        for c in ast.children(e):
-            visit(c)
-
-    visit(expr)
+        elif not isinstance(e, ast.Quant):  # its body reads one element at a time: no single value to show
+            todo.extend(reversed(ast.children(e)))
     return out

@@ -16,6 +16,7 @@ from .fieldmodel import FieldModel
 from .fmt import format_expr
 from .library import ActionDef, load_library
 from .attributes import AttrChecker
+from .deporder import dependency_order
 from .model import BoundAction, CheckedBehaviour, CheckedRule, CheckedSpec, TopicUse, Value
 from .paths import PathError, resolve
 from .source import SourceSet, Span
@@ -172,30 +173,10 @@ class _Checker:
 
     def order(self) -> List[str]:
         """Rule keys, each after the rules it uses; reports cycles."""
-        done: List[str] = []
-        state: Dict[str, int] = {}
-        path: List[str] = []  # the rules being visited, outermost first (shared: no copy per step)
-        at: Dict[str, int] = {}  # rule key -> its index in path
+        def cycle(keys: List[str]) -> None:
+            self.error(self.rule_asts[keys[0]].name.span, f"cyclic rule reference: {' -> '.join(keys)}")
 
-        def visit(key: str) -> None:
-            if state.get(key) == 2:
-                return
-            if state.get(key) == 1:
-                cycle = path[at[key]:] + [key]
-                self.error(self.rule_asts[key].name.span, f"cyclic rule reference: {' -> '.join(cycle)}")
-                return
-            state[key] = 1
-            at[key] = len(path)
-            path.append(key)
-            for dep in sorted(self.used_rules.get(key, ())):
-                visit(dep)
-            path.pop()
-            state[key] = 2
-            done.append(key)
-
-        for key in self.rule_asts:
-            visit(key)
-        return done
+        return dependency_order(self.rule_asts, lambda key: sorted(self.used_rules.get(key, ())), cycle)
 
     def evaluation_order(self, behaviours: List[CheckedBehaviour]) -> List[str]:
         """Rules ('entity.rule') and behaviours ('b:N') in one dependency order (§14): what an
@@ -215,36 +196,18 @@ class _Checker:
             deps[f"active({act})"] = who
         spans = {f"b:{b.index}": b.span for b in behaviours}
         names = {f"b:{b.index}": b.label for b in behaviours}
-        done: List[str] = []
-        state: Dict[str, int] = {}
-        path: List[str] = []  # the nodes being visited, outermost first
-        at: Dict[str, int] = {}  # node -> its index in path
 
-        def visit(node: str) -> None:
-            if state.get(node) == 2:
-                return
-            if state.get(node) == 1:
-                cycle = path[at[node]:] + [node]
-                if any(c.startswith("active(") for c in cycle):
-                    owner = next(c for c in cycle if c.startswith("b:"))
-                    chain = " -> ".join(names.get(c, c) for c in cycle[cycle.index(owner):] + cycle[1:cycle.index(owner) + 1]) \
-                        if cycle[0] != owner else " -> ".join(names.get(c, c) for c in cycle)
-                    self.error(spans[owner], f"{names[owner]} depends on active() of one of its own actions, so it "
-                                             f"could hold itself on: {chain}")
-                return
-            state[node] = 1
-            at[node] = len(path)
-            path.append(node)
-            for dep in deps.get(node, ()):
-                visit(dep)
-            path.pop()
-            state[node] = 2
-            if not node.startswith("active("):
-                done.append(node)
+        def cycle(nodes: List[str]) -> None:
+            if any(c.startswith("active(") for c in nodes):
+                owner = next(c for c in nodes if c.startswith("b:"))
+                chain = " -> ".join(names.get(c, c) for c in nodes[nodes.index(owner):] + nodes[1:nodes.index(owner) + 1]) \
+                    if nodes[0] != owner else " -> ".join(names.get(c, c) for c in nodes)
+                self.error(spans[owner], f"{names[owner]} depends on active() of one of its own actions, so it "
+                                         f"could hold itself on: {chain}")
 
-        for node in list(self.rule_asts) + [f"b:{b.index}" for b in behaviours]:
-            visit(node)
-        return done
+        order = dependency_order(list(self.rule_asts) + [f"b:{b.index}" for b in behaviours],
+                                 lambda node: deps.get(node, ()), cycle)
+        return [node for node in order if not node.startswith("active(")]
 
     # -- actions -------------------------------------------------------------------------
     def load_libraries(self, extra: Sequence[str]) -> Tuple[Dict[str, ActionDef], List[str]]:

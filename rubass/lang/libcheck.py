@@ -11,6 +11,7 @@ from .errors import Diagnostic, did_you_mean
 from .library import ActionDef
 from .msgdef import INTEGERS, FieldDef, MsgSpec, Registry
 from .source import SourceSet, Span
+from .yamltags import plain_value
 
 _FLOATS = ("float32", "float64")
 
@@ -108,7 +109,7 @@ _NOT_SCALAR = object()
 def _scalar(node: yaml.Node) -> Any:
     if not isinstance(node, yaml.ScalarNode):
         return _NOT_SCALAR
-    return yaml.SafeLoader("").construct_object(node, deep=True)
+    return plain_value(node)
 
 
 def _show(node: yaml.Node) -> str:

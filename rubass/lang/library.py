@@ -13,7 +13,7 @@ from .errors import Diagnostic, did_you_mean
 from .grammar import KEYWORDS
 from .source import Source, SourceSet, Span
 from .units import FREQUENCY, SPEED, TIME, Dimension, dim, dimension_name, parse_quantity
-from .yamltags import foreign_tags
+from .yamltags import foreign_tags, plain_value
 
 BUILTIN_PLUGINS = ("publish", "serial", "service", "log", "limit")
 CUSTOM_PLUGIN_RE = re.compile(r"[A-Za-z_][A-Za-z0-9_]*(?:\.[A-Za-z_][A-Za-z0-9_]*)*:[A-Za-z_][A-Za-z0-9_]*")
@@ -58,7 +58,7 @@ class _Node:
         return Span(self.file, mark.line + 1, mark.column + 1, mark.index, self.node.end_mark.index)
 
     def value(self) -> Any:
-        return yaml.SafeLoader("").construct_object(self.node, deep=True)
+        return plain_value(self.node)
 
 
 Checker = Callable[[_Node, str], Tuple[Any, Optional[str]]]

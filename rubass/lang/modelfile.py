@@ -11,7 +11,7 @@ from .msgdef import TYPE_RE, DefinitionError, parse_msg
 from .source import Source, SourceSet, Span
 from .sysmodel import SystemModel
 from .units import DIMENSIONLESS, UNITS, Dimension
-from .yamltags import PLAIN_TAGS, foreign_tags
+from .yamltags import PLAIN_TAGS, foreign_tags, plain_value
 
 KEYS = ("rubass_model", "source", "topics", "nodes", "units", "definitions")
 TOPIC_RE = re.compile(r"/?[A-Za-z_][A-Za-z0-9_]*(?:/[A-Za-z_][A-Za-z0-9_]*)*/?")
@@ -23,7 +23,7 @@ def _span(node: yaml.Node, file: str) -> Span:
 
 
 def _plain(node: yaml.Node) -> Any:
-    return yaml.SafeLoader("").construct_object(node, deep=True)
+    return plain_value(node)
 
 
 class _Reader:

@@ -3,7 +3,7 @@ from __future__ import annotations
 
 import os
 import stat
-from typing import Optional, Tuple
+from typing import BinaryIO, Optional, Tuple
 
 from .errors import Diagnostic
 from .source import Source, Span
@@ -25,7 +25,10 @@ def read_source(path: str, what: str = "spec") -> Tuple[Optional[Source], Option
             return None, Diagnostic(here, f"cannot read {what}: {size} bytes is over the limit of "
                                           f"{MAX_BYTES} bytes")
         with open(path, "rb") as fh:
-            data = fh.read(MAX_BYTES + 1)
+            data = read_at_most(fh, MAX_BYTES + 1)
+        if len(data) > MAX_BYTES:
+            return None, Diagnostic(here, f"cannot read {what}: it grew past the limit of {MAX_BYTES} bytes "
+                                          f"while being read")
     except FileNotFoundError:
         return None, Diagnostic(here, f"cannot read {what}: no such file")
     except PermissionError:
@@ -33,6 +36,23 @@ def read_source(path: str, what: str = "spec") -> Tuple[Optional[Source], Option
     except OSError as exc:
         return None, Diagnostic(here, f"cannot read {what}: {exc.strerror or exc}")
     return decode_source(path, data, what)
+
+
+def read_at_most(fh: BinaryIO, limit: int) -> bytes:
+    """Up to `limit` bytes of an open file, in a buffer the size of the file, not of the limit.
+
+    fh.read(limit) allocates `limit` bytes first: 4 MiB for every spec and library a reload
+    reads. A file that grows while it is read is read on, up to the limit."""
+    size = os.fstat(fh.fileno()).st_size
+    parts = [fh.read(min(size, limit - 1) + 1)]
+    got = len(parts[0])
+    while got > size and got < limit:  # it grew: read on in small steps
+        more = fh.read(min(1 << 16, limit - got))
+        if not more:
+            break
+        parts.append(more)
+        got += len(more)
+    return parts[0] if len(parts) == 1 else b"".join(parts)
 
 
 def decode_source(name: str, data: bytes, what: str = "spec") -> Tuple[Optional[Source], Optional[Diagnostic]]:

@@ -2,7 +2,7 @@
 custom '!tags'), so that a file is reported as an error rather than a loader traceback."""
 from __future__ import annotations
 
-from typing import AbstractSet, List
+from typing import AbstractSet, Any, List
 
 import yaml
 
@@ -26,3 +26,14 @@ def foreign_tags(root: yaml.Node, allowed: AbstractSet[str] = SAFE_TAGS) -> List
         elif isinstance(node, yaml.SequenceNode):
             todo += list(node.value)
     return sorted(out, key=lambda n: n.start_mark.index)
+
+
+def plain_value(node: yaml.Node) -> Any:
+    """The Python value of a composed node (a safe loader builds it). The loader is disposed of
+    after: an undisposed loader refers to itself, so it, the node and the whole file it read
+    would wait for the cyclic garbage collector (a reload's garbage would pile up until then)."""
+    loader = yaml.SafeLoader("")
+    try:
+        return loader.construct_object(node, deep=True)
+    finally:
+        loader.dispose()

@@ -86,8 +86,7 @@ class Monitor(Reloading):
         self.rejected = 0
         self.last_reload_error = ""
         self._reload_lock = threading.RLock()
-        self._pending_lock = threading.Lock()
-        self._reload_waiting = False
+        self._reload_wanted = threading.Event()  # a SIGHUP asked for a reload (reload_thread)
         self.coalesced = 0
         self._stopping = False
         self._exit = threading.Event()
@@ -257,8 +256,8 @@ class Monitor(Reloading):
                                         1.0 / self.config.master_rate, _log)
         rospy.Service("~reload", Trigger, lambda req: TriggerResponse(*self.reload("service")))
         rospy.Service("~reset", Trigger, lambda req: TriggerResponse(*self.reset()))
-        signal.signal(signal.SIGHUP, lambda signum, frame: threading.Thread(
-            target=self.reload_coalesced, args=("SIGHUP",), name="rubass-reload", daemon=True).start())
+        threading.Thread(target=self.reload_thread, name="rubass-reload", daemon=True).start()
+        signal.signal(signal.SIGHUP, lambda signum, frame: self.request_reload())
         # our own SIGINT/SIGTERM: release actions while publishers still work, then stop rospy
         # (after rospy's own handler, publish() silently does nothing)
         for sig in (signal.SIGINT, signal.SIGTERM):

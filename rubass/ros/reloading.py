@@ -44,22 +44,30 @@ class Reloading:
     coalesced: int
     last_reload_error: str
     load_error: str
-    _pending_lock: threading.Lock
     _reload_lock: threading.RLock
-    _reload_waiting: bool
+    _reload_wanted: threading.Event
 
-    def reload_coalesced(self, reason: str) -> None:
-        """Reload, unless another request is already waiting behind the running reload: that
-        one will read the newest files anyway, so a storm of SIGHUPs costs at most two reloads."""
-        with self._pending_lock:
-            if self._reload_waiting:
-                self.coalesced += 1
-                return
-            self._reload_waiting = True
-        with self._reload_lock:
-            with self._pending_lock:
-                self._reload_waiting = False
-            self.reload(reason)
+    def request_reload(self) -> None:
+        """From the SIGHUP handler: wake the reload thread. A request that arrives while another
+        waits behind the running reload is coalesced into it: that one reads the newest files
+        anyway, so a storm of SIGHUPs costs at most two reloads."""
+        if self._reload_wanted.is_set():
+            self.coalesced += 1
+        self._reload_wanted.set()
+
+    def reload_thread(self) -> None:
+        """The one thread that runs every SIGHUP reload, for the monitor's lifetime: a storm of
+        SIGHUPs starts no threads. Whatever a reload raises, it lives on for the next one."""
+        while True:
+            self._reload_wanted.wait()
+            self._reload_wanted.clear()
+            try:
+                self.reload("SIGHUP")
+            except queue.Empty:
+                rospy.logerr("rubass: reload (SIGHUP): the engine's thread did not take the new rules within "
+                             "its timeout (stalled?); the swap may still happen when it answers")
+            except Exception as exc:  # noqa: BLE001 - the next SIGHUP must still be served
+                rospy.logerr("rubass: reload (SIGHUP) failed: %s: %s", exc.__class__.__name__, exc)
 
     def reload(self, reason: str) -> Tuple[bool, str]:
         """Re-read spec and libraries; swap atomically, or keep the old rules on any error."""

@@ -60,3 +60,43 @@ def test_a_named_active_behaviour_whose_rule_changed_is_released_by_its_runner_a
     assert [e.kind for e in new.on_message("/x", 3.0, {"data": 0.0}) if e.kind != "rule"] == ["release"]
     changed = check_text(text.format(2).replace("{ warn; }", '{ warn("other"); }'), os.path.join(ROOT, "s.rbs"), [LIB])
     assert Dispatcher.keys(changed.behaviours)[1] != Dispatcher.keys(new_spec.behaviours)[1]  # other actions
+
+
+def test_sighups_are_served_by_one_thread_that_coalesces_a_storm_and_outlives_a_failed_reload(monkeypatch):
+    import threading
+    import time
+
+    monitor = FakeMonitor(None)
+    monitor._reload_wanted, monitor.coalesced = threading.Event(), 0
+    calls, logged, gate = [], [], threading.Event()
+
+    def reload(reason):
+        calls.append((reason, threading.current_thread().name))
+        if len(calls) == 1:
+            gate.wait(10)
+            raise RuntimeError("a bug in a reload")
+        return True, "reloaded"
+
+    def wait_for(n):
+        end = time.monotonic() + 10
+        while len(calls) < n and time.monotonic() < end:
+            time.sleep(0.01)
+        return len(calls)
+
+    monitor.reload = reload
+    monkeypatch.setattr(reloading.rospy, "logerr", lambda fmt, *args: logged.append(fmt % args))
+    worker = threading.Thread(target=monitor.reload_thread, name="rubass-reload", daemon=True)
+    worker.start()
+    before = threading.active_count()
+    monitor.request_reload()
+    assert wait_for(1) == 1
+    for _ in range(50):  # while the first reload runs: one waits behind it, 49 join that one
+        monitor.request_reload()
+    assert monitor.coalesced == 49 and threading.active_count() == before, "a SIGHUP starts no thread"
+    gate.set()
+    assert wait_for(2) == 2
+    time.sleep(0.2)
+    assert len(calls) == 2 and worker.is_alive()
+    assert logged == ["rubass: reload (SIGHUP) failed: RuntimeError: a bug in a reload"]
+    monitor.request_reload()  # the thread serves the next SIGHUP
+    assert wait_for(3) == 3 and calls == [("SIGHUP", "rubass-reload")] * 3
