@@ -67,6 +67,7 @@ from ..actions.errorguard import ErrorGuard
 from ..actions.keeper import LatchKeeper
 from ..actions.latches import LatchFile, default_path
 from .params import MonitorConfig, ParamError, read_config
+from .timerslack import exact_timers
 from .reloading import ConfigError, Reloading, StartupError
 from .topics import TopicWatcher, ros_now
 
@@ -328,6 +329,7 @@ class Monitor(Reloading):
     def _engine_thread(self) -> None:
         loop = self.loop
         assert loop is not None
+        exact_timers()  # deadlines wake this thread: not up to 50 µs late (docs/engine.md)
         while not self._stopping:
             try:
                 loop.step(max_wait=0.1)
