@@ -6,9 +6,18 @@ the monitor, so nodes started afterwards (a restarted driver, a new base control
 connect to it. Connections made before the restart are peer to peer and keep working.
 
 MasterWatch asks the master, a few times a second, whether it still knows this node
-(lookupNode of our own name, with a timeout). When it does not, it registers every
-publisher, subscriber and service of this process again, with the URIs they already have,
-and hands each subscription the new master's publisher list, as rospy does at start-up.
+(lookupNode of our own name) and what its process id is (getPid), each with a timeout. It
+registers every publisher, subscriber and service of this process again, with the URIs they
+already have, and hands each subscription the new master's publisher list, as rospy does at
+start-up, at the first poll (the master may have restarted since rospy registered) and
+whenever the master
+- does not know this node;
+- is back after the watch could not reach it; or
+- answers from another process than before.
+"Knows this node" alone is not enough: a publisher, subscriber or service created while the
+master is down (the monitor starting, a reload that names a new topic) makes rospy retry that
+one registration until the master is back, and that one registration is enough for the new
+master to know the node, while it knows nothing of the others.
 Nothing is torn down, so the existing connections, the ones that carry the stop to the
 robot's base, are never interrupted.
 """
@@ -80,6 +89,7 @@ class MasterWatch:
         self.state = "connected"
         self.reregistrations = 0
         self.down_since: Optional[float] = None  # monotonic time of the first failed poll
+        self.master_pid: Optional[int] = None  # the process that answered the last poll
         self._caller = rpc.Caller(master_uri, timeout)  # polled: one kept connection
         self._stop = threading.Event()
         self._thread: Optional[threading.Thread] = None
@@ -105,6 +115,7 @@ class MasterWatch:
         """One poll: 'ok', 'unreachable', 'foreign' (another node holds our name) or 're-registered'."""
         try:
             code, msg, uri = self._caller.call("lookupNode", self.caller_id, self.caller_id)
+            pid = self._caller.call("getPid", self.caller_id)[2]
         except (OSError, socket.error, xmlrpc.client.Error) as exc:
             if self.down_since is None:
                 self.down_since = time.monotonic()
@@ -113,20 +124,31 @@ class MasterWatch:
                                  f"connect to the monitor until the master is back")
             self.state = f"unreachable for {time.monotonic() - self.down_since:.1f} s"
             return "unreachable"
-        was_down = self.down_since
-        self.down_since = None
-        if code == 1 and uri == self.node_uri:
-            if was_down is not None:
-                self.log("info", f"the master at {self.master_uri} is back and still knows this node")
-            self.state = "connected"
-            return "ok"
-        if code == 1:  # rospy shuts a node down when another takes its name; do not fight over it
+        was_down, self.down_since = self.down_since, None
+        was_pid, self.master_pid = self.master_pid, pid
+        if code == 1 and uri != self.node_uri:  # rospy shuts a node down when another takes its name: no fight
             self.state = f"another node ({uri}) holds the name {self.caller_id}"
             return "foreign"
-        reg = register_all(rpc.proxy(self.master_uri, self.timeout), self.caller_id, self.node_uri)
-        self.reregistrations += 1
+        if code == 1 and was_down is None and was_pid == pid:
+            self.state = "connected"
+            return "ok"
+        why = ("did not know this node (it restarted)" if code != 1 else
+               "is back after being unreachable" if was_down is not None else
+               "" if was_pid is None else  # the first poll: the master may have restarted since rospy registered
+               f"answers from another process (pid {was_pid}, now {pid}: it restarted)")
+        try:
+            reg = register_all(rpc.proxy(self.master_uri, self.timeout), self.caller_id, self.node_uri)
+        except Exception:
+            self.master_pid = was_pid  # not done: the next poll tries again
+            if was_down is not None:
+                self.down_since = was_down
+            raise
         self.state = "connected"
-        self.log("warn", f"the master at {self.master_uri} did not know this node (it restarted): registered "
-                         f"{reg.publishers} publishers, {reg.subscribers} subscribers and {reg.services} services "
-                         f"again in {reg.ms:.1f} ms")
+        if not why:
+            self.log("debug", f"the master at {self.master_uri} (pid {pid}) has every registration of this node "
+                              f"({reg.ms:.1f} ms)")
+            return "ok"
+        self.reregistrations += 1
+        self.log("warn", f"the master at {self.master_uri} {why}: registered {reg.publishers} publishers, "
+                         f"{reg.subscribers} subscribers and {reg.services} services again in {reg.ms:.1f} ms")
         return "re-registered"

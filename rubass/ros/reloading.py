@@ -16,6 +16,7 @@ from ..engine import Engine
 from ..lang import SpecError, load_spec
 from ..lang.errors import RubassError
 from ..lang.model import CheckedSpec
+from .gcfreeze import freeze_heap
 from .topics import ros_now
 
 
@@ -85,6 +86,7 @@ class Reloading:
                     self._enforce(spec, self._runners(spec, {}))
                     self.reloads += 1
                     self.last_reload_error = ""
+                    freeze_heap()
                     return True, f"enforcing {spec.path}: {len(spec.rules)} rules, {len(spec.behaviours)} behaviours"
                 if spec.behaviours == [] and self.spec.behaviours:
                     raise StartupError(f"{spec.path}: the new spec has no behaviours; refusing to drop every "
@@ -135,6 +137,7 @@ class Reloading:
                 runner.plugin.close()
             self.reloads += 1
             self.last_reload_error = ""
+            freeze_heap()  # the new spec and engine leave the collector's scans, as at start (gcfreeze.py)
             ms = (time.monotonic() - t0) * 1000.0
             rospy.loginfo("rubass: reloaded %s (%s) in %.0f ms: %d rules, %d behaviours (check %.0f ms, build %.0f ms, "
                           "swap %.1f ms)", spec.path, reason, ms, len(spec.rules), len(spec.behaviours),

@@ -54,6 +54,36 @@ def test_after_a_master_restart_the_monitor_re_registers_and_still_stops_the_rob
     assert mon.poll() is None
 
 
+def test_a_topic_subscribed_while_the_master_is_down_does_not_hide_the_lost_registrations(ros, tmp_path):
+    """A reload that names a new topic while the master is down: rospy retries that one
+    registration until the master is back, and then the new master knows the node, but
+    nothing else of it. The watch registers everything again: it saw the master unreachable,
+    or, when its poll fell outside the outage, the master answers from another process."""
+    import threading
+
+    import rosgraph
+
+    path = spec(tmp_path, FAST)
+    mon = ros.monitor(path, master_rate=0.5)  # a poll every 2 s: rospy's retry (every 0.2 s) comes first
+    wait_log(mon, ros, "enforcing")
+    time.sleep(2.5)  # after the watch's first poll, which registers everything anyway
+    restart = threading.Thread(target=ros.master.restart, kwargs={"down": 1.0})
+    restart.start()
+    time.sleep(0.3)
+    with open(path, "a") as fh:
+        fh.write("entity odom { rules: fast: topic /odom.twist.twist.linear.x > 5.0 m/s; }\n"
+                 "if (odom.fast) then { stop; }\n")
+    os.kill(mon.pid, signal.SIGHUP)
+    restart.join()
+    master = rosgraph.Master("/test", master_uri=ros.master.uri)
+    while not (monitor_registered(master, "/cmd_vel") and monitor_registered(master, "/odom")):
+        assert time.time() - ros.master.online_at < 2.0 + 0.5, ros.log(mon)  # a poll period + slack
+        time.sleep(0.01)
+    wait_log(mon, ros, "reloaded")
+    assert "services again in" in ros.log(mon)
+    assert mon.poll() is None
+
+
 def test_while_the_master_is_down_the_rules_keep_being_enforced(ros, tmp_path):
     mon = ros.monitor(spec(tmp_path, FAST), master_rate=4)
     driver = ros.probe_bg({"listen": [{"topic": "/safety_cmd", "type": TWIST}],
