@@ -71,6 +71,7 @@ def main():
         "violations": result.get("expected"), "missed": result.get("unanswered"),
         "reaction_ms_p50": round(_common.percentile(lat, 50) * 1e3, 3),
         "reaction_ms_p99": round(_common.percentile(lat, 99) * 1e3, 3),
+        "reaction_ms_max": round(max(lat) * 1e3, 3) if lat else None,
         "rss_warm_mb": round(warm / 1e6, 2), "rss_end_mb": round(samples[-1][1] / 1e6, 2),
         "rss_growth_mb": round((samples[-1][1] - warm) / 1e6, 2), "monitor_alive": alive,
         **_common.machine()}))
