@@ -27,7 +27,7 @@ class ScriptedMaster:
         pass
 
 
-def run(polls, fail=()):
+def run(monkeypatch, polls, fail=()):
     """The result of each poll, and after which polls everything was registered again."""
     watch = MasterWatch("/rubass", ME, "http://master:11311", 0.25, lambda level, text: None)
     watch._caller = ScriptedMaster(polls)
@@ -39,57 +39,54 @@ def run(polls, fail=()):
         registered.append(len(results))
         return Registered(1, 1, 1, 1.0)
 
-    original = master_watch.register_all
-    master_watch.register_all = register_all
-    try:
-        for _ in polls:
-            try:
-                results.append(watch.check())
-            except IOError:
-                results.append("failed")
-    finally:
-        master_watch.register_all = original
+    monkeypatch.setattr(master_watch, "register_all", register_all)
+    for _ in polls:
+        try:
+            results.append(watch.check())
+        except IOError:
+            results.append("failed")
     return results, registered, watch
 
 
-def test_the_first_poll_registers_everything_once_then_a_steady_master_is_left_alone():
-    results, registered, watch = run([(ME, 7), (ME, 7), (ME, 7)])
+def test_the_first_poll_registers_everything_once_then_a_steady_master_is_left_alone(monkeypatch):
+    results, registered, watch = run(monkeypatch, [(ME, 7), (ME, 7), (ME, 7)])
     assert results == ["ok", "ok", "ok"] and registered == [0]
     assert watch.reregistrations == 0 and watch.state == "connected"
 
 
-def test_a_master_that_forgot_the_node_gets_everything_again():
-    results, registered, watch = run([(ME, 7), (None, 7), (ME, 7)])
+def test_a_master_that_forgot_the_node_gets_everything_again(monkeypatch):
+    results, registered, watch = run(monkeypatch, [(ME, 7), (None, 7), (ME, 7)])
     assert results == ["ok", "re-registered", "ok"] and registered == [0, 1]
     assert watch.reregistrations == 1
 
 
-def test_after_an_outage_everything_is_registered_again_even_when_the_master_knows_the_node():
+def test_after_an_outage_everything_is_registered_again_even_when_the_master_knows_the_node(monkeypatch):
     # rospy retried one registration made during the outage: the new master knows the node
-    results, registered, watch = run([(ME, 7), OSError("refused"), OSError("refused"), (ME, 7), (ME, 7)])
+    polls = [(ME, 7), OSError("refused"), OSError("refused"), (ME, 7), (ME, 7)]
+    results, registered, watch = run(monkeypatch, polls)
     assert results == ["ok", "unreachable", "unreachable", "re-registered", "ok"]
     assert registered == [0, 3] and watch.down_since is None
 
 
-def test_a_master_process_that_changed_between_two_polls_gets_everything_again():
-    results, registered, _ = run([(ME, 7), (ME, 8), (ME, 8)])
+def test_a_master_process_that_changed_between_two_polls_gets_everything_again(monkeypatch):
+    results, registered, _ = run(monkeypatch, [(ME, 7), (ME, 8), (ME, 8)])
     assert results == ["ok", "re-registered", "ok"] and registered == [0, 1]
 
 
-def test_a_refused_registration_is_tried_again_at_the_next_poll():
-    results, registered, watch = run([(ME, 7), (ME, 8), (ME, 8), (ME, 8)], fail={1})
+def test_a_refused_registration_is_tried_again_at_the_next_poll(monkeypatch):
+    results, registered, watch = run(monkeypatch, [(ME, 7), (ME, 8), (ME, 8), (ME, 8)], fail={1})
     assert results == ["ok", "failed", "re-registered", "ok"] and registered == [0, 2]
-    results, registered, watch = run([(ME, 7), OSError("down"), (ME, 7), (ME, 7), (ME, 7)], fail={2})
+    results, registered, watch = run(monkeypatch, [(ME, 7), OSError("down"), (ME, 7), (ME, 7), (ME, 7)], fail={2})
     assert results == ["ok", "unreachable", "failed", "re-registered", "ok"] and registered == [0, 3]
 
 
-def test_another_node_holding_our_name_is_not_fought_over():
-    results, registered, watch = run([(ME, 7), ("http://other:5000/", 7)])
+def test_another_node_holding_our_name_is_not_fought_over(monkeypatch):
+    results, registered, watch = run(monkeypatch, [(ME, 7), ("http://other:5000/", 7)])
     assert results == ["ok", "foreign"] and registered == [0]
     assert "holds the name" in watch.state
 
 
-def test_an_unreachable_master_is_reported_with_how_long():
-    results, registered, watch = run([OSError("down")] * 3)
+def test_an_unreachable_master_is_reported_with_how_long(monkeypatch):
+    results, registered, watch = run(monkeypatch, [OSError("down")] * 3)
     assert results == ["unreachable"] * 3 and registered == []
     assert watch.state.startswith("unreachable for")
