@@ -159,7 +159,7 @@ class ExprChecker(BuiltinChecks):
             self.error(e.span, f"two arrays in one {self.quant.func}(): 'topic {array.topic}{array.path_text}' and "
                                f"'topic {self.quant.array.topic}{self.quant.array.path_text}'; every array term "
                                "inside one quantifier must run over the same array")
-        return ast.Elem(elem, span=e.span), self._field_ty(e)
+        return ast.Elem(elem, span=e.span), self._field_ty(e, array=True)
 
     def _field_ty(self, e: ast.TopicRef, array: bool = False) -> Ty:
         """What the system model says of a field (no model: unknown kind and dimension)."""

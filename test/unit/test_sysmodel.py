@@ -263,3 +263,27 @@ def test_urdf_joint_kinds():
         urdf_joint_kinds("<sdf/>")
     with pytest.raises(ValueError, match="not valid XML"):
         urdf_joint_kinds("<robot")
+
+
+def test_quantifiers_and_array_terms_check_against_a_model():
+    """any/all/count over `[*]` and slices, and len() of a whole array of messages, are accepted
+    with a model (they were rejected as 'is an array' whenever a model was given)."""
+    from rubass.lang.loader import check_source
+
+    text = ("entity e { rules:\n"
+            "  low: any(topic /battery.cells[*].voltage < 3.2 V);\n"
+            "  hot: count(topic /battery.cells[0:2].temp > 60) >= 1;\n"
+            "  near: all(topic /scan.ranges[*] > 0.2 m);\n"
+            "  four: len(topic /battery.cells) == 4;\n"
+            "  front: min(topic /scan.ranges[0:90]) < 0.4 m;\n}\n")
+    checked = check_source(Source("q.rbs", text), model=model())
+    assert {r.key for r in checked.rules} == {"e.low", "e.hot", "e.near", "e.four", "e.front"}
+
+
+def test_a_quantifier_over_a_field_that_is_not_there_says_why_with_a_model():
+    from rubass.lang.errors import SpecError
+    from rubass.lang.loader import check_source
+
+    text = "entity e { rules:\n  low: any(topic /battery.cells[*].volts < 3.2);\n}\n"
+    with pytest.raises(SpecError, match=r"q.rbs:2:12: .*has no field 'volts'"):
+        check_source(Source("q.rbs", text), model=model())
