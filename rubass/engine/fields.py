@@ -82,6 +82,11 @@ def _walk(msg: Any, path: Tuple[PathElem, ...]) -> Tuple[Any, bool]:
     return value, False
 
 
+def _is_message(value: Any) -> bool:
+    """A message (genpy, or a test's dict), not a time: its fields are read by name."""
+    return isinstance(value, dict) or (hasattr(value, "__slots__") and not callable(getattr(value, "to_sec", None)))
+
+
 def convert(value: Any, path: Tuple[PathElem, ...] = ()) -> Any:
     """A message value as an engine value."""
     if type(value) is float:  # the common case first
@@ -100,6 +105,8 @@ def convert(value: Any, path: Tuple[PathElem, ...] = ()) -> Any:
     if isinstance(value, (list, tuple)):
         if value and type(value[0]) in (float, int):  # a numeric array (ROS arrays are typed):
             return tuple(value)  # copied as it is; min/max skip its NaNs (no per-element work here)
+        if value and _is_message(value[0]):  # an array of messages: its elements stay messages, as
+            return tuple(value)  # `[*]` gives them (len() of it; a value is unknown, as any array's)
         return tuple(convert(v, path) for v in value)
     to_sec = getattr(value, "to_sec", None)  # rospy Time / Duration
     if callable(to_sec):

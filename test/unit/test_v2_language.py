@@ -220,3 +220,21 @@ def test_a_witness_of_an_infinite_value_is_valid_json(tmp_path):
     start = [e for e in engine.on_message("/s", 1.0, {"r": [float("inf")]}) if e.kind == "start"][0]
     text = json.dumps(start.witness.as_json(), allow_nan=False)  # Infinity is not JSON
     assert json.loads(text)["witnesses"] == {"min(/s.r)": "inf"}
+
+
+def test_len_of_a_whole_array_of_messages_counts_them(tmp_path):
+    """§4/§12: len() of an array field whose elements are messages, written without brackets,
+    counts them as len(...[*]) does (it was always unknown: the messages were read as values)."""
+    from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
+
+    spec = ok(tmp_path, HEAD + "entity e { rules:\n  n3: len(topic /d.status) == 3;\n"
+                               "  star3: len(topic /d.status[*]) == 3;\n  none: len(topic /d.status) == 0;\n}\n"
+                               "if (e.n3) then { stop; }\n")
+    engine = Engine(spec, 0.0)
+    engine.evaluate_all(0.0)
+    engine.on_message("/d", 1.0, DiagnosticArray(status=[DiagnosticStatus(level=v) for v in (0, 2, 1)]))
+    assert [engine.store.rules[k] for k in ("e.n3", "e.star3", "e.none")] == [True, True, False]
+    engine.on_message("/d", 2.0, {"status": [{"level": 1}, {"level": 2}]})  # a rule test's message
+    assert [engine.store.rules[k] for k in ("e.n3", "e.none")] == [False, False]
+    engine.on_message("/d", 3.0, DiagnosticArray(status=[]))
+    assert [engine.store.rules[k] for k in ("e.n3", "e.none")] == [False, True]
