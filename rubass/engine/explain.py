@@ -6,12 +6,16 @@ condition uses, directly or through other rules, that are true at that instant, 
 field and function value that the condition and those rules read, as the engine's store holds
 them then. Labels are written as in a spec without the `topic`/`node` keywords, so a safety
 engineer can match them to the rules: `/odom.twist.twist.linear.x`, `age(/cmd_vel)`,
-`cpu(controller)`, `min(/scan.ranges[0:90])`. Values are SI (a share of one core for cpu,
-bytes for memory); each function's unit is given beside it.
+`cpu(controller)`, `min(/scan.ranges[0:90])`. A quantifier or a zone function is read as a whole and
+labelled with its own text as written (comments and extra spaces left out):
+`count(/scan.ranges[*] < 0.4 m)`, `distance(/odom.pose.pose.position.x, /odom.pose.pose.position.y, CELL)`;
+a zone's X and Y are read besides. Values are SI (a share of one core for cpu, bytes for memory);
+each function's unit is given beside it.
 """
 from __future__ import annotations
 
 import math
+import re
 from dataclasses import dataclass
 from typing import Any, Callable, Dict, List, Optional, Sequence, Tuple
 
@@ -91,12 +95,51 @@ def _checked_label(e: ast.Expr) -> Optional[Tuple[str, str]]:
     return None
 
 
-def label(e: ast.Expr) -> Optional[str]:
-    """How a witness names a term, or None for what is not a reading."""
+def label(e: ast.Expr, sources: Any = None) -> Optional[str]:
+    """How a witness names a term, or None for what is not a reading. A quantifier or a zone function
+    is named by its text in `sources` (a SourceSet) when it can be found there."""
     if isinstance(e, ast.TopicRef):
         return e.topic + e.path_text
+    if isinstance(e, (ast.Quant, ast.Zone)):
+        src = sources.get(e.span.file) if sources is not None else None
+        written = call_text(src.text, e.span.start) if src is not None else None
+        if written is not None:
+            return written
+        if isinstance(e, ast.Quant):
+            return f"{e.func}({e.ref.topic}{e.ref.path_text}[*] …)"
+        return f"{e.func}({label(e.x) or '…'}, {label(e.y) or '…'}, …)"
     checked = _checked_label(e)
     return checked[0] if checked is not None else None
+
+
+def _whole_unit(e: ast.Expr) -> str:
+    """The unit of a term read as a whole that _checked_label does not know."""
+    return "m" if isinstance(e, ast.Zone) and e.func == "distance" else ""
+
+
+_CALL_LEX = re.compile(r'"(?:[^"\\\n]|\\.)*"|//[^\n]*|/\*[\s\S]*?\*/|[()]')
+_KEYWORD = re.compile(r"\b(?:topic|node)\s+(?=[/A-Za-z_~])")
+
+
+def call_text(text: str, start: int) -> Optional[str]:
+    """The text of the call written at `start` (a name and its balanced parentheses) on one line,
+    without comments or the `topic`/`node` keywords; None when no call stands there."""
+    depth, pieces, last = 0, [], start
+    for m in _CALL_LEX.finditer(text, start):
+        tok = m.group(0)
+        if tok.startswith("/"):  # a comment
+            pieces += [text[last:m.start()], " "]
+            last = m.end()
+        elif tok == "(":
+            depth += 1
+        elif tok == ")":
+            depth -= 1
+            if depth <= 0:
+                pieces.append(text[last:m.end()])
+                out = " ".join("".join(pieces).split())
+                out = re.sub(r"\(\s+", "(", re.sub(r"\s+\)", ")", out))
+                return _KEYWORD.sub("", out) if depth == 0 else None
+    return None
 
 
 def _json_value(v: Any) -> Any:
@@ -166,7 +209,7 @@ class Explainer:
             return cached
         out: List[Tuple[str, str, Callable[[], Any]]] = []
         for e in _terms(expr):
-            term = label(e)
+            term = label(e, getattr(self.spec, "sources", None))
             if term is None:
                 continue
             if isinstance(e, ast.TopicRef):
@@ -177,7 +220,8 @@ class Explainer:
                 fn = self._compile(e)
             except Exception:  # a construct this explainer cannot read alone: leave it out
                 continue
-            out.append((term, _checked_label(e)[1], fn))  # type: ignore[index]
+            checked = _checked_label(e)
+            out.append((term, checked[1] if checked is not None else _whole_unit(e), fn))
         self._readers[key] = out
         return out
 
@@ -188,16 +232,19 @@ def _rule_refs(expr: ast.Expr) -> List[str]:
 
 def _terms(expr: ast.Expr) -> Sequence[ast.Expr]:
     """Readings in reading order; a function's own topic argument is not read separately,
-    nor is a whole array (its min/max/len is)."""
+    nor is a whole array (its min/max/len is); a quantifier is read as a whole (its body reads one
+    element at a time: no single value to show), a zone as a whole and its X and Y besides."""
     out: List[ast.Expr] = []
     todo = [expr]  # a stack, not a recursive closure: a closure that calls itself is a reference
     while todo:    # cycle, and the engine it serves would wait for the cyclic collector
         e = todo.pop()
-        if _checked_label(e) is not None:
+        if _checked_label(e) is not None or isinstance(e, ast.Quant):
             out.append(e)
         elif isinstance(e, ast.TopicRef):
             if e.path:
                 out.append(e)
-        elif not isinstance(e, ast.Quant):  # its body reads one element at a time: no single value to show
+        else:
+            if isinstance(e, ast.Zone):
+                out.append(e)
             todo.extend(reversed(ast.children(e)))
     return out

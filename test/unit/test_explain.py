@@ -144,3 +144,49 @@ def test_witness_benchmark_runs_and_finds_no_call_on_the_message_path():
     assert out.returncode == 0, out.stderr
     figures = json.loads(out.stdout)
     assert figures["explain_calls_on_the_message_path"] == 0 and figures["one_witness_us"] > 0
+
+
+QSPEC = """action primitive stop;
+const CELL = polygon((0 m, 0 m), (1 m, 0 m), (1 m, 1 m));
+entity b { rules:
+  close: count(topic /scan.ranges[*] < 0.4 m) > 1;
+  near: any(topic /scan.ranges[0:2] <  /* tight */ 0.4 m);
+  edge: distance(topic /odom.pose.pose.position.x, topic /odom.pose.pose.position.y, CELL) < 0.2 m;
+}
+if (b.close) then { stop; }
+if (b.near) then { stop; }
+if (b.edge) then { stop; }
+"""
+
+
+def qengine():
+    e = Engine(check_text(QSPEC, os.path.join(ROOT, "q.rbs"), [LIB]), 0.0)
+    e.evaluate_all(0.0)
+    return e
+
+
+def test_quantifiers_are_witnessed_with_their_value_as_written():
+    e = qengine()
+    events = e.on_message("/scan", 0.1, {"ranges": [0.1, 0.2, 0.3, 0.35, 1.0]})
+    starts = {ev.behaviour: ev.witness for ev in events if ev.kind == "start"}
+    assert starts[1].values() == {"count(/scan.ranges[*] < 0.4 m)": 4.0}
+    assert starts[2].values() == {"any(/scan.ranges[0:2] < 0.4 m)": True}  # the comment left out
+    assert "count(/scan.ranges[*] < 0.4 m) = 4" in [r.text() for r in starts[1].readings]
+    assert json.dumps(starts[1].as_json())
+
+
+def test_distance_is_witnessed_besides_its_x_and_y():
+    e = qengine()
+    events = e.on_message("/odom", 0.1, {"pose": {"pose": {"position": {"x": 0.9, "y": 0.1}}}})
+    (start,) = [ev for ev in events if ev.kind == "start"]
+    vals = start.witness.values()
+    assert abs(vals["distance(/odom.pose.pose.position.x, /odom.pose.pose.position.y, CELL)"] - 0.1) < 1e-9
+    assert vals["/odom.pose.pose.position.x"] == 0.9 and vals["/odom.pose.pose.position.y"] == 0.1
+    assert start.witness.units()["distance(/odom.pose.pose.position.x, /odom.pose.pose.position.y, CELL)"] == "m"
+
+
+def test_quantifier_and_zone_labels_without_sources():
+    q = ast.Quant("count", ast.TopicRef("/scan", ("ranges",)), ast.Lit(True))
+    assert label(q) == "count(/scan.ranges[*] …)"
+    z = ast.Zone("inside", ast.TopicRef("/p", ("x",)), ast.TopicRef("/p", ("y",)), ())
+    assert label(z) == "inside(/p.x, /p.y, …)"
