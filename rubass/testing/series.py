@@ -15,7 +15,9 @@ from ..lang.units import parse_quantity
 GAP: Any = object()  # a step with no message
 
 _NUM = r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?"
-_WORD = re.compile(r'"(?:[^"\\]|\\.)*"|\'[^\']*\'|\S+')
+_QUOTED = r'"(?:[^"\\]|\\.)*"|\'[^\']*\''
+_WORD = re.compile(rf"(?:{_QUOTED})\S*|\S+")  # a quoted string with what follows it: '"a b"x3'
+_QUOTED_WORD = re.compile(rf"({_QUOTED})(\S*)")
 _RAMP = re.compile(rf"({_NUM})([-+](?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)x(\d+)")
 _REPEAT = re.compile(r"(.+)x(\d+)")
 _MAX_STEPS = 10_000_000
@@ -64,7 +66,16 @@ def expand(text: Any) -> List[Any]:
 
 def _word(word: str) -> List[Any]:
     if word[0] in "\"'":
-        return [value(word)]
+        m = _QUOTED_WORD.fullmatch(word)
+        if m is None:  # an opening quote never closed
+            raise SeriesError(f"'{word}': a quoted string needs its closing quote")
+        text, rest = m.groups()
+        if not rest:
+            return [value(text)]  # an x inside the quotes is part of the string
+        n = re.fullmatch(r"x(\d+)", rest)
+        if n is None:
+            raise SeriesError(f"'{rest}' after the string {text} is not xN (a string repeated N times)")
+        return _repeat(word, value(text), int(n.group(1)))
     if word == "_":
         return [GAP]
     m = _RAMP.fullmatch(word)
@@ -73,9 +84,11 @@ def _word(word: str) -> List[Any]:
         return [round(a + k * b, 12) for k in range(n)]  # 0.1 * 3 is 0.3 here, as the author meant
     m = _REPEAT.fullmatch(word)
     if m:
-        n = int(m.group(2))
-        if n > _MAX_STEPS:
-            raise SeriesError(f"'{word}': more than {_MAX_STEPS} steps")
-        v = GAP if m.group(1) == "_" else value(m.group(1))
-        return [v] * n
+        return _repeat(word, GAP if m.group(1) == "_" else value(m.group(1)), int(m.group(2)))
     return [value(word)]
+
+
+def _repeat(word: str, v: Any, n: int) -> List[Any]:
+    if n > _MAX_STEPS:
+        raise SeriesError(f"'{word}': more than {_MAX_STEPS} steps")
+    return [v] * n
