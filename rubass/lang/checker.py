@@ -29,6 +29,7 @@ class _Checker:
     def __init__(self, spec: ast.Spec, sources: SourceSet, model: Optional[FieldModel] = None) -> None:
         self.spec, self.sources, self.model = spec, sources, model
         self.diags: List[Diagnostic] = []
+        self._unusable_libraries: List[str] = []  # imported libraries that could not be read at all
         self.warnings: List[Diagnostic] = []
         self.consts: Dict[str, ast.Const] = {}
         self.const_values: Dict[str, Tuple[ast.Lit, Ty]] = {}
@@ -232,6 +233,8 @@ class _Checker:
                 continue
             lib, diags = load_library(path, self.sources)
             self.diags.extend(diags)
+            if not lib and any(d.severity == "error" and not d.subject for d in diags):
+                self._unusable_libraries.append(path)  # its own error says why; its actions are not "undefined"
             if self.sources.get(path) is not None:  # read, even if some actions were invalid
                 loaded.append(path)
             for name, act in lib.items():
@@ -252,7 +255,8 @@ class _Checker:
                                                     "warning"))
                     continue
                 declared[ident.name] = ident.span
-                if ident.name not in library and not self._broken_in_library(ident.name):
+                if ident.name not in library and not self._broken_in_library(ident.name) \
+                        and not self._unusable_libraries:
                     where = ("no action library is loaded: add 'import \"actions.yaml\";' or pass --actions"
                              if not loaded else "loaded: " + ", ".join(loaded))
                     self.error(ident.span, f"action '{ident.name}' is not defined in any action library "

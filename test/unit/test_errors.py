@@ -180,3 +180,12 @@ def test_absolute_import(write, tmp_path):
     spec = check_text(f'import "{lib}";\naction primitive stop;\nentity e {{ rules: r: topic /v.x > 1; }}\n'
                       "if (e.r) then { stop; }\n", str(tmp_path / "s.rbs"))
     assert spec.actions["stop"].plugin == "publish"
+
+
+@pytest.mark.parametrize("lib", ["actions:\n  stop: {plugin: publish, topic: /c\n  warn: {plugin: log}\n",
+                                 "- stop\n", "action:\n  stop: {}\n"], ids=["not YAML", "not a mapping", "no key"])
+def test_a_library_that_cannot_be_read_is_the_only_error_its_actions_get(write, lib):
+    """Its own error says what is wrong; 'action is not defined in any action library' for each of
+    its actions, printed first, sent the user to the spec instead (acceptance finding)."""
+    found = errors(write, HEAD + "entity e { rules: r: topic /v.x > 1; }\nif (e.r) then { stop; }\n", lib)
+    assert len(found) == 1 and "not defined" not in found[0][2], found
