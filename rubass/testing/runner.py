@@ -54,6 +54,26 @@ def _global(name: str) -> str:
     return name if name.startswith("/") else "/" + name.lstrip("~")
 
 
+def _absolute(stamp: Any) -> Any:
+    """A header stamp in test time as the engine's absolute time; 0 stays the zero stamp."""
+    if isinstance(stamp, (int, float)) and not isinstance(stamp, bool) and stamp != 0:
+        if stamp < 0:
+            raise MessageError(f"'header.stamp' is a time (test time in seconds): {stamp!r} is before the "
+                               f"test's start (0 s)")
+        return EPOCH + stamp
+    return stamp
+
+
+def _test_time(fpath: Tuple[Any, ...], value: Any) -> Any:
+    """`value` to assign at `fpath`, with the message's header stamp in test time however it is
+    written: `header.stamp: T` (a path, or a series of it) or `header: {stamp: T}` (a mapping)."""
+    if fpath == STAMP:
+        return _absolute(value)
+    if fpath == STAMP[:1] and isinstance(value, dict) and "stamp" in value:
+        return {**value, "stamp": _absolute(value["stamp"])}
+    return value
+
+
 def _stream(spec: CheckedSpec, case: Case, path: str, warnings: List[str]) -> List[Tuple[float, str, Any]]:
     from ..ros.msgtypes import check_path
 
@@ -93,9 +113,7 @@ def _stream(spec: CheckedSpec, case: Case, path: str, warnings: List[str]) -> Li
         for part in parts:
             try:
                 for fpath, value in part.assignments:
-                    if fpath == STAMP and isinstance(value, (int, float)) and value != 0:
-                        value = EPOCH + value  # test time; 0 stays the zero stamp
-                    assign(msg, fpath, value)
+                    assign(msg, fpath, _test_time(fpath, value))
             except MessageError as exc:
                 raise TestFileError(path, part.line, f"{topic} ({case.topics[topic].type_name}): {exc}") from None
         try:
