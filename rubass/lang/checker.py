@@ -11,7 +11,7 @@ import os
 from typing import Any, Callable, Dict, FrozenSet, Iterator, List, Optional, Sequence, Set, Tuple
 
 from . import ast
-from .errors import Diagnostic, did_you_mean
+from .errors import Diagnostic, a_noun, did_you_mean
 from .fieldmodel import FieldModel
 from .fmt import format_expr
 from .library import ActionDef, load_library
@@ -63,7 +63,7 @@ class _Checker:
             if isinstance(d, (ast.Const, ast.Entity)):
                 kind = "constant" if isinstance(d, ast.Const) else "entity"
                 if d.name.name in top:
-                    self.error(d.name.span, f"duplicate name '{d.name.name}' (a {kind}); first defined at "
+                    self.error(d.name.span, f"duplicate name '{d.name.name}' ({a_noun(kind)}); first defined at "
                                             f"{top[d.name.name]}")
                     continue
                 top[d.name.name] = d.name.span

@@ -55,6 +55,13 @@ class SpecError(RubassError):
         return "\n".join(d.render(self.sources) for d in self.diagnostics)
 
 
+def a_noun(noun: str) -> str:
+    """The noun with its indefinite article: 'a time', 'an entity', 'a quantity in m*s'."""
+    if not noun.replace(" ", "").isalpha():  # a formula of units, such as m*s or m^3
+        return f"a quantity in {noun}"
+    return ("an " if noun[:1] in "aeiou" else "a ") + noun
+
+
 def did_you_mean(name: str, candidates: Iterable[str]) -> str:
     """A suggestion suffix for an unknown name, or '' when nothing is close."""
     close = difflib.get_close_matches(name, sorted(set(candidates)), n=1, cutoff=0.6)

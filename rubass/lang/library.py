@@ -9,7 +9,7 @@ from typing import Any, Callable, Dict, Iterable, List, Optional, Tuple
 
 import yaml
 
-from .errors import Diagnostic, did_you_mean
+from .errors import Diagnostic, a_noun, did_you_mean
 from .grammar import KEYWORDS
 from .source import Source, SourceSet, Span
 from .units import FREQUENCY, SPEED, TIME, Dimension, dim, dimension_name, parse_quantity
@@ -131,14 +131,11 @@ def _quantity(d: Dimension, unit: str, example: str) -> Checker:
     return check
 
 
-def _a(noun: str) -> str:
-    return ("an " if noun[:1] in "aeiou" else "a ") + noun
-
 
 def _range(d: Dimension, unit: str) -> Checker:
     """[min, max] with units of dimension d (a bare 0 needs none); SI floats, min <= max."""
     units = _UNITS_OF[unit]
-    what = _a(dimension_name(d))
+    what = a_noun(dimension_name(d))
 
     def check(n: _Node, key: str) -> Tuple[Any, Optional[str]]:
         v = n.value()
@@ -153,7 +150,7 @@ def _range(d: Dimension, unit: str) -> Checker:
             if not q[1] and q[0] != 0:
                 return None, f"'{key}': {item!r} needs a unit ({units}), such as '{item} {unit}'"
             if q[1] and q[1] != d:
-                return None, f"'{key}' takes {what} ({units}), got {item!r} ({_a(dimension_name(q[1]))})"
+                return None, f"'{key}' takes {what} ({units}), got {item!r} ({a_noun(dimension_name(q[1]))})"
             out.append(q[0])
         if out[0] > out[1]:
             return None, f"'{key}': min {v[0]!r} is greater than max {v[1]!r}"

@@ -8,7 +8,7 @@ from typing import Any, Callable, Dict, FrozenSet, List, Optional, Set, Tuple, U
 
 from . import ast
 from .builtins import BuiltinChecks
-from .errors import Diagnostic, did_you_mean
+from .errors import Diagnostic, a_noun, did_you_mean
 from .fieldmodel import FieldModel
 from .grammar import FUNCTIONS
 from .ops import BINARY, SCALAR_FUNCTIONS, UNARY, scalar_fn
@@ -333,12 +333,8 @@ class ExprChecker(BuiltinChecks):
     def _same_dim(self, a: Ty, b: Ty, span: Span, template: str) -> None:
         if a.kind == b.kind == "num" and a.dim is not None and b.dim is not None \
                 and not a.bare and not b.bare and a.dim != b.dim:
-            self.error(span, template.format(_a(dimension_name(a.dim)), _a(dimension_name(b.dim))))
+            self.error(span, template.format(a_noun(dimension_name(a.dim)), a_noun(dimension_name(b.dim))))
 
-
-def _a(noun: str) -> str:
-    """The noun with its indefinite article: 'a time', 'an acceleration'."""
-    return ("an " if noun[:1] in "aeiou" else "a ") + noun
 
 
 def _join(a: Ty, b: Ty) -> Ty:

@@ -41,7 +41,7 @@ CASES = [
      (5, 3, "duplicate rule 'r' in entity 'e'; first defined at {dir}/s.rbs:4:3")),
     ("duplicate top-level name",
      HEAD + "const e = 1;\nentity e { rules: r: topic /v.x > 1; }\nif (e.r) then { stop; }\n",
-     (4, 8, "duplicate name 'e' (a entity); first defined at {dir}/s.rbs:3:7")),
+     (4, 8, "duplicate name 'e' (an entity); first defined at {dir}/s.rbs:3:7")),
     ("undeclared action",
      HEAD + "entity e { rules: r: topic /v.x > 1; }\nif (e.r) then { stpo; }\n",
      (4, 17, "action 'stpo' is not declared: add 'action primitive stpo;'; did you mean 'stop'?")),
@@ -189,3 +189,11 @@ def test_a_library_that_cannot_be_read_is_the_only_error_its_actions_get(write, 
     its actions, printed first, sent the user to the spec instead (acceptance finding)."""
     found = errors(write, HEAD + "entity e { rules: r: topic /v.x > 1; }\nif (e.r) then { stop; }\n", lib)
     assert len(found) == 1 and "not defined" not in found[0][2], found
+
+
+def test_articles_and_unit_formulas_read_as_english(write):
+    found = errors(write, HEAD + "const e = 1;\nentity e { rules: r: age(topic /v) * 1 m > 1 m; }\n"
+                          "entity f { rules: r: age(topic /v) * 1 m > 1 m; }\nif (f.r) then { stop; }\n")
+    messages = [m for _, _, m in found]
+    assert any(m.startswith("duplicate name 'e' (an entity)") for m in messages), messages
+    assert "compares a quantity in m*s with a length" in messages, messages
