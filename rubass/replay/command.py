@@ -10,6 +10,7 @@ from typing import Any, Iterable, Iterator, Set, Tuple
 
 from ..lang import SpecError, load_spec
 from . import report
+from .names import resolve, spellings
 
 
 def register(sub: "argparse._SubParsersAction[argparse.ArgumentParser]") -> None:
@@ -78,7 +79,7 @@ def run(args: argparse.Namespace) -> int:
         print(f"rubass replay: error: {exc}", file=sys.stderr)
         return 1
     with bag:
-        topic_map = {_global(t): t for t in spec.topics}  # bag name -> spec name
+        topic_map = spellings(spec.topics)  # bag name -> every spelling of it in the spec (docs/replay.md)
         for name in sorted(topic_map):
             if name not in info.types:
                 print(f"rubass replay: warning: topic {name} is not in {args.bag}; its values stay unknown",
@@ -90,7 +91,7 @@ def run(args: argparse.Namespace) -> int:
             print("rubass replay: warning: the recording has no node samples (a monitor's ~node_samples or the "
                   "agents' /rubass/agent_samples); alive(), cpu() and memory() stay unknown", file=sys.stderr)
         present = [t for t in topic_map if t in info.types]
-        decode: Set[str] = {t for t in present if spec.topics[topic_map[t]].needs_data}
+        decode: Set[str] = {t for t in present if any(spec.topics[n].needs_data for n in topic_map[t])}
         try:
             classes = message_classes(bag, sorted(decode))
         except BagError as exc:
@@ -99,12 +100,12 @@ def run(args: argparse.Namespace) -> int:
         errors = []
         readers = [((t, p), owners) for t, paths in spec.field_readers().items() for p, owners in paths.items()]
         for (topic, path), owners in sorted(readers, key=str):
-            cls = classes.get(_global(topic))
+            cls = classes.get(resolve(topic))
             problem = check_path(cls, path) if cls is not None else None
             if problem:
                 field = "".join(f"[{p}]" if isinstance(p, int) else f".{p}" for p in path)
                 errors.append(f"rubass replay: error: {' and '.join(owners)} reads {topic}{field}, but in "
-                              f"{info.types[_global(topic)]}: {problem}")
+                              f"{info.types[resolve(topic)]}: {problem}")
         if errors:
             print("\n".join(errors), file=sys.stderr)
             return 1
@@ -125,8 +126,8 @@ def run(args: argparse.Namespace) -> int:
         agent_topics = agent_topics if spec.nodes else []
         stream: Iterable[Tuple[float, str, Any]] = read(bag, present + node_topics + agent_topics,
                                                         decode | set(node_topics) | set(agent_topics))
-        if any(name != spec_name for name, spec_name in topic_map.items()):  # relative names in the spec
-            stream = ((t, topic_map.get(topic, topic), msg) for t, topic, msg in stream)
+        if any(names != [name] for name, names in topic_map.items()):  # relative, private or several spellings
+            stream = ((t, name, msg) for t, topic, msg in stream for name in topic_map.get(topic, (topic,)))
         if agent_topics:  # multi-host: the agents' reports, for the nodes the monitor's samples do not cover
             from .agents import SAMPLES, agent_samples
 

@@ -14,6 +14,7 @@ from ..engine import Event
 from ..lang.ast import path_suffix
 from ..lang.errors import did_you_mean
 from ..lang.model import CheckedSpec
+from ..replay.names import spellings
 from ..replay.run import replay
 from .format import UNSET, Case, Expect, MessageInput
 from .messages import MessageError, assign, has_header
@@ -77,7 +78,7 @@ def _test_time(fpath: Tuple[Any, ...], value: Any) -> Any:
 def _stream(spec: CheckedSpec, case: Case, path: str, warnings: List[str]) -> List[Tuple[float, str, Any]]:
     from ..ros.msgtypes import check_path
 
-    names = {_global(t): t for t in spec.topics}
+    names = spellings(spec.topics)  # resolved -> every spelling of it in the spec, each fed every message
     end = case.end
     readers = spec.field_readers()
     for topic, t in case.topics.items():
@@ -85,7 +86,7 @@ def _stream(spec: CheckedSpec, case: Case, path: str, warnings: List[str]) -> Li
             warnings.append(f"{path}:{t.line}: warning: the spec reads no topic {topic}"
                             f"{did_you_mean(topic, names)}; its messages change nothing")
             continue
-        for fpath, owners in readers.get(names[topic], {}).items():
+        for fpath, owners in [r for n in names[topic] for r in readers.get(n, {}).items()]:
             plain = []
             for p in fpath:  # up to a slice or [*] (§12): what lies beyond is per element
                 if not isinstance(p, (str, int)):
@@ -121,8 +122,8 @@ def _stream(spec: CheckedSpec, case: Case, path: str, warnings: List[str]) -> Li
         except Exception as exc:  # genpy raises SerializationError, struct.error, TypeError…
             raise TestFileError(path, parts[0].line, f"the message of {topic} at {time:g} s does not fit "
                                                      f"{case.topics[topic].type_name}: {exc}") from None
-        if topic in names:
-            out.append((EPOCH + time, 0, names[topic], msg))
+        for name in names.get(topic, ()):
+            out.append((EPOCH + time, 0, name, msg))
     state: Dict[str, Dict[str, Any]] = {}
     nodes = {_global(n): n for n in spec.nodes}
     for s in sorted(case.nodes, key=lambda s: s.time):
