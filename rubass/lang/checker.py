@@ -251,8 +251,8 @@ class _Checker:
                 continue
             for ident in d.names:
                 if ident.name in declared:
-                    self.warnings.append(Diagnostic(ident.span, f"action '{ident.name}' is declared twice",
-                                                    "warning"))
+                    self.error(ident.span, f"duplicate action '{ident.name}': already declared at "
+                                           f"{declared[ident.name]}")  # duplicate names are errors (§9)
                     continue
                 declared[ident.name] = ident.span
                 if ident.name not in library and not self._broken_in_library(ident.name) \

@@ -45,6 +45,10 @@ CASES = [
     ("undeclared action",
      HEAD + "entity e { rules: r: topic /v.x > 1; }\nif (e.r) then { stpo; }\n",
      (4, 17, "action 'stpo' is not declared: add 'action primitive stpo;'; did you mean 'stop'?")),
+    ("an action declared twice",
+     'import "actions.yaml";\naction primitive stop;\naction primitive stop;\n'
+     "entity e { rules: r: topic /v.x > 1; }\nif (e.r) then { stop; }\n",
+     (3, 18, "duplicate action 'stop': already declared at {dir}/s.rbs:2:18")),
     ("declared action missing from the libraries",
      HEAD.replace("stop;", "stop, brake;") + "entity e { rules: r: topic /v.x > 1; }\nif (e.r) then { brake; }\n",
      (2, 24, "action 'brake' is not defined in any action library (loaded: {dir}/actions.yaml)")),
