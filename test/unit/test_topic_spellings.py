@@ -105,3 +105,35 @@ def test_replay_feeds_every_spelling_of_a_topic(write, tmp_path, capsys):
     assert rules["e.priv_age"] == [(0.0, False)]
     starts = sorted((e["behaviour"], round(e["time"], 3)) for e in events if e["event"] == "start")
     assert starts == [(1, 0.5), (2, 0.5), (3, 1.0)]
+
+
+BAD = """import "lib.yaml";
+action primitive warn;
+entity e {
+  rules:
+    priv_: topic ~p.dat > 1;
+}
+if (e.priv_) then { warn; }
+"""
+
+
+def test_a_private_topics_fields_are_checked_against_its_resolved_topic(write, tmp_path, capsys):
+    write("lib.yaml", LIB)
+    spec = write("robot.rbs", BAD)
+    path = write("t.test.yaml", """spec: robot.rbs
+tests:
+  - name: bad field
+    topics:
+      /rubass/p: {type: std_msgs/Float64, messages: [{at: 0.5 s, data: 2}]}
+""")
+    code, out, err = run(capsys, "test", path)
+    assert code == 2 and "reads /rubass/p.dat" in err and "has no field 'dat'" in err, out + err
+    rosbag = pytest.importorskip("rosbag")
+    import rospy
+    from std_msgs.msg import Float64
+
+    bag = str(tmp_path / "p.bag")
+    with rosbag.Bag(bag, "w") as b:
+        b.write("/rubass/p", Float64(2.0), rospy.Time.from_sec(100.0))
+    code, out, err = run(capsys, "replay", spec, bag)
+    assert code == 1 and "reads ~p.dat, but in std_msgs/Float64" in err, out + err
