@@ -156,9 +156,16 @@ class ExprChecker(BuiltinChecks):
         if self.quant.array is None:
             self.quant.array = array
         elif self.quant.array != array:
-            self.error(e.span, f"two arrays in one {self.quant.func}(): 'topic {array.topic}{array.path_text}' and "
-                               f"'topic {self.quant.array.topic}{self.quant.array.path_text}'; every array term "
-                               "inside one quantifier must run over the same array")
+            first = self.quant.array
+            if (first.topic, first.path[:-1]) == (array.topic, array.path[:-1]):
+                self.error(e.span, f"two slices of one array in one {self.quant.func}(): 'topic {array.topic}"
+                                   f"{array.path_text}' and 'topic {first.topic}{first.path_text}'; the array terms "
+                                   "of a quantifier advance together, element by element, so they must be the "
+                                   "same slice")
+            else:
+                self.error(e.span, f"two arrays in one {self.quant.func}(): 'topic {array.topic}{array.path_text}' "
+                                   f"and 'topic {first.topic}{first.path_text}'; every array term inside one "
+                                   "quantifier must run over the same array")
         return ast.Elem(elem, span=e.span), self._field_ty(e, array=True)
 
     def _field_ty(self, e: ast.TopicRef, array: bool = False) -> Ty:

@@ -92,6 +92,9 @@ CASES = [
      (3, 35, "the number '1e999' is too large")),
     ("for of a division by zero", HEAD + "entity e { rules: r: topic /v.x > 1 for (1 s / 0); }\nif (e.r) then { stop; }\n",
      (3, 46, "the duration of 'for' is not a number")),
+    ("two slices of one array in one quantifier", HEAD + "entity e { rules: r: any(topic /a.data[0:2] < "
+     "topic /a.data[1:3]); }\nif (e.r) then { stop; }\n", (3, 47, "two slices of one array in one any(): "
+                                                             "'topic /a.data[1:3]' and 'topic /a.data[0:2]'")),
     ("a count compared with a length", HEAD + "entity e { rules: r: len(topic /d.status[*]) > 2 m; }\n"
      "if (e.r) then { stop; }\n", (3, 46, "compares a count with a length")),
     ("a behaviour named like an action", HEAD + "entity e { rules: r: topic /v.x > 1; }\n"
