@@ -19,7 +19,8 @@ class AttrChecker:
 
     def __init__(self, diags: List[Diagnostic]) -> None:
         self.diags = diags
-        self.ids: Dict[str, Span] = {}
+        self.ids: Dict[str, Span] = {}  # each id -> where it is first given in the source
+        self._given: Dict[str, List[Span]] = {}  # each id -> every place it is given, as visited
 
     def own(self, attrs: Sequence[ast.Attr], what: str) -> Attrs:
         """The attributes written on one entity, rule or behaviour, checked."""
@@ -39,12 +40,8 @@ class AttrChecker:
                                                      f"values in one, e.g. @{a.name}(\"A\", \"B\")"
                                              if most is None else f"@{a.name} is given twice on this {what}"))
                 continue
-            if a.name == "id":
-                first = self.ids.get(a.args[0])
-                if first is not None:
-                    self.diags.append(Diagnostic(a.span, f"duplicate id \"{a.args[0]}\"; first given at {first}"))
-                    continue
-                self.ids[a.args[0]] = a.span
+            if a.name == "id":  # duplicates are reported by check_rules, in source order
+                self._given.setdefault(a.args[0], []).append(a.span)
             out[a.name] = tuple(a.args)
         return out
 
@@ -55,6 +52,17 @@ class AttrChecker:
                             for name, ent in entities.items() for r in ent.rules}
         self._inherited = {name: {k: v for k, v in attrs.items() if k not in NOT_INHERITED}
                            for name, attrs in self._entity_attrs.items()}
+        self.report_duplicate_ids()
+
+    def report_duplicate_ids(self) -> None:
+        """One error at each later place an id is given, naming the first place in the source (entities,
+        rules and behaviours are checked in different passes, so not in source order)."""
+        for value, spans in self._given.items():
+            ordered = sorted(set(spans), key=lambda sp: (sp.file, sp.line, sp.col))
+            self.ids[value] = ordered[0]
+            for later in ordered[1:]:
+                self.diags.append(Diagnostic(later, f"duplicate id \"{value}\"; first given at {ordered[0]}"))
+        self._given = {}
 
     def rule_attrs(self, entity: ast.Entity, rule: ast.Rule) -> Attrs:
         """A rule's attributes: its own, and for each attribute it lacks, its entity's (not the id)."""
@@ -63,3 +71,4 @@ class AttrChecker:
         if own:
             inherited.update(own)
         return inherited
+
