@@ -449,7 +449,7 @@ class Monitor(Reloading):
 
 
 def main(argv: Optional[List[str]] = None) -> int:
-    rospy.init_node("rubass_monitor", argv=argv, disable_signals=True)  # Monitor handles SIGINT/SIGTERM
+    rospy.init_node("rubass", argv=argv, disable_signals=True)  # Monitor handles SIGINT/SIGTERM
     sys.setswitchinterval(0.0005)  # a busy thread must not delay a deadline by the default 5 ms
     try:
         config = read_config(lambda name, default: rospy.get_param("~" + name, default),
