@@ -2,7 +2,7 @@
 what a rule inherits from its entity."""
 from __future__ import annotations
 
-from typing import Dict, List, Sequence, Tuple
+from typing import Dict, List, Optional, Sequence, Tuple
 
 from . import ast
 from .errors import Diagnostic, did_you_mean
@@ -72,3 +72,17 @@ class AttrChecker:
             inherited.update(own)
         return inherited
 
+
+def entity_ids(spec: ast.Spec) -> Dict[str, str]:
+    """Each entity's @id (entities that have one), by entity name. An entity's id names the entity: its
+    rules do not take it as their own @id (§15), but it names those of its rules that have no id."""
+    return {d.name.name: a.args[0] for d in spec.decls if isinstance(d, ast.Entity)
+            for a in d.attrs if a.name == "id" and len(a.args) == 1}
+
+
+def rule_ids(attrs: Attrs, entity_id: Optional[str]) -> Tuple[str, ...]:
+    """The ids that name a rule: its own @id, else its entity's (none when neither has one)."""
+    own = attrs.get("id", ())
+    if own:
+        return tuple(own)
+    return (entity_id,) if entity_id else ()

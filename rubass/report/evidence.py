@@ -4,13 +4,14 @@ from __future__ import annotations
 
 import os
 from dataclasses import dataclass, field
-from typing import Any, Dict, List, Optional, Sequence, Set
+from typing import Any, Dict, List, Optional, Sequence, Set, Tuple
 
 import yaml
 
 from ..lang.errors import RubassError
 from ..engine import Event
 from ..lang import ast
+from ..lang.attributes import entity_ids, rule_ids
 from ..lang.model import CheckedSpec
 from ..testing.coverage import Coverage, coverage
 from ..testing.results import FileResult
@@ -94,6 +95,11 @@ def attrs(owner: Any) -> Dict[str, Sequence[str]]:
     return getattr(owner, "attrs", None) or {}
 
 
+def rule_ids_of(spec: CheckedSpec, rule: Any) -> Tuple[str, ...]:
+    """The ids that name a rule: its own @id, else its entity's (a test covering the entity covers it)."""
+    return rule_ids(attrs(rule), entity_ids(spec.spec).get(rule.entity))
+
+
 def behaviour_label(spec: CheckedSpec, index: int) -> str:
     b = spec.behaviours[index - 1]
     return b.name if getattr(b, "name", "") else f"behaviour {index}"
@@ -132,8 +138,8 @@ def build_matrix(ev: Evidence) -> None:
             continue
         for r in rules:
             users = [b for b in spec.behaviours if r.key in uses[b.index]]
-            ids = set(attrs(r).get("id", ()))
-            tests = [o for o in outcomes if ids & set(o.covers)]  # tests that name the rule's @id
+            ids = set(rule_ids_of(spec, r))
+            tests = [o for o in outcomes if ids & set(o.covers)]  # tests that name the rule's (or entity's) @id
             if not tests:  # else the tests that made it true (weaker evidence, but evidence)
                 tests = [o for o in outcomes if r.key in o.rules_true]
             ev.matrix.append(Row(h, r.key, [behaviour_label(spec, b.index) for b in users], tests, _gaps(users, tests)))

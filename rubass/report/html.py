@@ -7,8 +7,8 @@ import platform
 from html import escape
 from typing import Any, Iterable, List, Sequence
 
-from .evidence import (Evidence, attrs, behaviour_label, behaviour_time, design_times, hazards_via_rules, rule_time,
-                       spec_text)
+from .evidence import (Evidence, attrs, behaviour_label, behaviour_time, design_times, hazards_via_rules, rule_ids_of,
+                       rule_time, spec_text)
 from .timeline import svg
 
 CSS = """
@@ -43,6 +43,14 @@ def _list(items: Iterable[str]) -> str:
 
 def _attr(owner: Any, key: str) -> str:
     return _list(attrs(owner).get(key, ()))
+
+
+def _rule_id(ev: Evidence, rule: Any) -> str:
+    """A rule's id: its own, else its entity's, marked as the entity's."""
+    if attrs(rule).get("id"):
+        return _attr(rule, "id")
+    ids = rule_ids_of(ev.spec, rule)
+    return f"{_list(ids)} <span class='muted'>(entity {_e(rule.entity)})</span>" if ids else _list([])
 
 
 def _table(head: Sequence[str], rows: List[str]) -> str:
@@ -87,7 +95,7 @@ def _matrix(ev: Evidence) -> str:
         h = row.hazard
         details = "; ".join(f"{k}: {v}" for k, v in h.details.items())
         rule = ev.spec.rule(row.rule) if row.rule else None
-        rule_cell = (f"<code>{_e(row.rule)}</code><br>{_attr(rule, 'id')} {_e(' '.join(attrs(rule).get('title', ())))}"
+        rule_cell = (f"<code>{_e(row.rule)}</code><br>{_rule_id(ev, rule)} {_e(' '.join(attrs(rule).get('title', ())))}"
                      if rule is not None else '<span class="muted">—</span>')
         tests = "<br>".join(f"<span class='{'pass' if o.passed else 'fail'}'>{'✔' if o.passed else '✘'}</span> "
                             f"{_e(o.name)}" for o in row.tests) or '<span class="muted">—</span>'
@@ -97,7 +105,7 @@ def _matrix(ev: Evidence) -> str:
                     f"<td>{rule_cell}</td><td>{_list(row.behaviours)}</td><td>{tests}</td>{status}</tr>")
     note = ("<p>Each hazard of the risk assessment, the rules that detect it (<code>@hazard</code>), the behaviours "
             "that act on those rules, and the tests that cover them (those whose <code>covers</code> names the rule's "
-            "<code>@id</code>; when none does, those that made the rule true). Gaps are marked red: a hazard with no rule, a rule with no test, a failing test.</p>")
+            "<code>@id</code>, or its entity's when the rule has none; when none does, those that made the rule true). Gaps are marked red: a hazard with no rule, a rule with no test, a failing test.</p>")
     return "<h2 id='matrix'>Hazard → rule → behaviour → test</h2>" + note + \
         _table(["hazard", "rule", "behaviours", "tests", "status"], rows)
 
@@ -121,7 +129,7 @@ def _rules(ev: Evidence) -> str:
         if total != sum(times):
             times = [total]  # through the rules it uses
         bound = f"{_seconds(times)}" + (f" + ≤ {worst:g} ms = ≤ {total + worst / 1000:.4g} s" if worst is not None else "")
-        rows.append(f"<tr><td><code>{_e(r.key)}</code></td><td>{_attr(r, 'id')}</td><td>{_attr(r, 'hazard')}</td>"
+        rows.append(f"<tr><td><code>{_e(r.key)}</code></td><td>{_rule_id(ev, r)}</td><td>{_attr(r, 'hazard')}</td>"
                     f"<td>{_attr(r, 'title')}</td><td>{_attr(r, 'ref')}</td><td>{bound}</td>"
                     f"<td><pre>{_e(spec_text(ev.spec, r.span))}</pre></td></tr>")
     return ("<h2 id='rules'>Rules</h2>" + _reaction_note(ev)

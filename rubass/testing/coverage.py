@@ -4,6 +4,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import List, Set, Tuple
 
+from ..lang.attributes import entity_ids
 from ..lang.model import CheckedSpec
 from .runner import Outcome
 
@@ -19,17 +20,21 @@ class Coverage:
 
 
 def traced(spec: CheckedSpec) -> Tuple[List[str], List[str]]:
-    """The spec's @id values and @hazard values (rules, with inherited ones, and behaviours), in order."""
+    """The spec's @id values (entities, rules and behaviours) and @hazard values (rules, with inherited
+    ones, and behaviours), in order."""
     ids: List[str] = []
     hazards: List[str] = []
+    by_entity = entity_ids(spec.spec)
     for owner in list(spec.rules) + list(spec.behaviours):
         attrs = getattr(owner, "attrs", None) or {}
-        for v in attrs.get("id", ()):
+        entity_id = by_entity.get(getattr(owner, "entity", ""))
+        for v in ((entity_id,) if entity_id else ()) + tuple(attrs.get("id", ())):
             if v not in ids:
                 ids.append(v)
         for v in attrs.get("hazard", ()):
             if v not in hazards:
                 hazards.append(v)
+    ids += [v for v in by_entity.values() if v not in ids]  # an entity with no rule
     return ids, hazards
 
 

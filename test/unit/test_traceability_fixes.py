@@ -1,12 +1,78 @@
 """Traceability fixes of issue 16: an entity's @id is a known id, duplicate ids in source order, bad
 report inputs exit 1, one gap is "1 gap"."""
 import os
+import re
 
 import pytest
 
+from rubass.cli import main
 from rubass.lang import SpecError, check_text
+from rubass.testing.coverage import traced, unknown_covers
 
 from conftest import ROOT
+
+LIB = """actions:
+  stop: {plugin: log, level: warn}
+"""
+SPEC = """import "lib.yaml";
+action primitive stop;
+@id("E-1") @hazard("H1") entity base {
+  rules:
+    too_fast: topic /odom.twist.twist.linear.x > 0.5 m/s;
+    @id("SR-2") far: topic /odom.pose.pose.position.x > 100 m;
+}
+@id("SF-1") overspeed: if (base.too_fast) then { stop; }
+far: if (base.far) then { stop; }
+"""
+TEST = """spec: e.rbs
+tests:
+  - name: overspeed stops
+    covers: [{covers}]
+    topics:
+      /odom: {{type: nav_msgs/Odometry, rate: 10 Hz, field: twist.twist.linear.x, values: "0x10 0.6x20"}}
+    expect:
+      - {{at: 1 s, start: overspeed}}
+"""
+
+
+@pytest.fixture
+def spec_path(write):
+    write("lib.yaml", LIB)
+    return write("e.rbs", SPEC)
+
+
+def test_an_entity_id_is_a_known_id(spec_path):
+    spec = check_text(SPEC, spec_path)
+    ids, _ = traced(spec)
+    assert ids == ["E-1", "SR-2", "SF-1"]
+    assert unknown_covers(spec, ["E-1", "E-2"]) == ["E-2"]
+    assert spec.rule("base.too_fast").attrs.get("id") is None  # the rule does not take it as its own (§15)
+
+
+def test_coverage_lists_an_entity_id_no_test_covers(spec_path, write, capsys):
+    tests = write("e.test.yaml", TEST.format(covers="SF-1"))
+    assert main(["test", "--coverage", tests]) == 0
+    out = capsys.readouterr()
+    assert "ids no test covers: E-1, SR-2" in out.out
+    tests = write("e.test.yaml", TEST.format(covers="E-1"))
+    assert main(["test", "--coverage", tests]) == 0
+    out = capsys.readouterr()
+    assert "ids no test covers: SR-2, SF-1" in out.out and "which is no @id" not in out.err + out.out
+
+
+def test_report_shows_the_entity_id_and_counts_its_tests(spec_path, write, tmp_path, capsys):
+    tests = write("e.test.yaml", TEST.format(covers="E-1"))
+    out = str(tmp_path / "r.html")
+    assert main(["report", spec_path, "--tests", tests, "-o", out]) == 0
+    html = open(out, encoding="utf-8").read()
+    rules = html.split("<h2 id='rules'>", 1)[1].split("<h2", 1)[0]
+    too_fast = re.search(r"<tr><td><code>base.too_fast</code></td><td>(.*?)</td>", rules).group(1)
+    assert too_fast.startswith("E-1") and "entity base" in too_fast  # inherited, marked as the entity's
+    far = re.search(r"<tr><td><code>base.far</code></td><td>(.*?)</td>", rules).group(1)
+    assert far == "SR-2"  # its own id
+    matrix = html.split("<h2 id='matrix'>", 1)[1].split("<h2", 1)[0]
+    row = re.search(r"<tr><td><b>H1</b>.*?base.too_fast.*?</tr>", matrix, re.S).group(0)
+    assert "E-1" in row and "overspeed stops" in row and "covered" in row
 
 
 def check_errors(text, tmp_path):
