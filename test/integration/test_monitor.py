@@ -330,3 +330,18 @@ def test_a_reload_that_would_drop_every_behaviour_is_refused(ros, tmp_path):
     out = ros.call("/rubass/reload")
     assert "success: False" in out.stdout and "refusing to drop every safety behaviour" in out.stdout
     assert mon.poll() is None
+
+
+def test_a_plain_rosrun_is_the_node_the_readme_names(ros, tmp_path):
+    """`rosrun rubass monitor _spec:=…` with no __name: the node is /rubass, as the launch file
+    and the README's `rosservice call /rubass/reload` say, and `~x` is /rubass/x."""
+    path = spec(tmp_path, "entity a { rules: r: topic ~x.data > 1; }\nif (a.r) then { stop; }\n")
+    mon = ros.spawn([PY, os.path.join(ROOT, "scripts", "monitor"), f"_spec:={path}"], "monitor-plain")
+    ros.wait_service("/rubass/reload", mon)
+    ros.wait_service("/rubass/reset", mon)
+    rec = ros.probe({"listen": [{"topic": "/safety_cmd", "type": TWIST}],
+                     "advertise": [{"topic": "/rubass/x", "type": "std_msgs/Float64"}],
+                     "steps": [{"wait_subscribers": "/rubass/x"}, {"wait_publishers": "/safety_cmd"}, {"sleep": 0.3},
+                               {"publish": "/rubass/x", "msg": {"data": 2.0}},
+                               {"wait": "/safety_cmd", "timeout": 5}]})
+    assert first(rec, "recv", "/safety_cmd") is not None, ros.log(mon)
