@@ -11,12 +11,13 @@ from .fieldmodel import FieldInfo
 from .msgdef import Registry
 from .msgpath import UnitTable, has_stamp, resolve
 from .std_units import STANDARD_UNITS
+from .topicnames import resolve as resolve_topic
 from .units import Dimension
 
 
 def norm_topic(name: str) -> str:
-    """'/cmd_vel' for 'cmd_vel', '/cmd_vel/' or '//cmd_vel'."""
-    return "/" + name.strip("/").replace("//", "/")
+    """'/cmd_vel' for 'cmd_vel', '/cmd_vel/' or '//cmd_vel'; '/rubass/x' for '~x' (topicnames.py)."""
+    return resolve_topic(name)
 
 
 @dataclass

@@ -1,4 +1,5 @@
-"""Topic names of a spec resolved as the live monitor resolves them, for replay and rule tests.
+"""Topic names of a spec resolved as the live monitor resolves them, for replay, rule tests and
+the system model.
 
 The monitor subscribes once per resolved name, and every spelling of a topic in the spec
 (`/cmd_vel`, `cmd_vel`, `~x`) gets every message (docs/monitor.md). Without a master there is

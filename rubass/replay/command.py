@@ -10,7 +10,7 @@ from typing import Any, Iterable, Iterator, Set, Tuple
 
 from ..lang import SpecError, load_spec
 from . import report
-from .names import resolve, spellings
+from ..lang.topicnames import resolve, spellings
 
 
 def register(sub: "argparse._SubParsersAction[argparse.ArgumentParser]") -> None:

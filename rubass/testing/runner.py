@@ -14,7 +14,7 @@ from ..engine import Event
 from ..lang.ast import path_suffix
 from ..lang.errors import did_you_mean
 from ..lang.model import CheckedSpec
-from ..replay.names import spellings
+from ..lang.topicnames import spellings
 from ..replay.run import replay
 from .format import UNSET, Case, Expect, MessageInput
 from .messages import MessageError, assign, has_header

@@ -287,3 +287,10 @@ def test_a_quantifier_over_a_field_that_is_not_there_says_why_with_a_model():
     text = "entity e { rules:\n  low: any(topic /battery.cells[*].volts < 3.2);\n}\n"
     with pytest.raises(SpecError, match=r"q.rbs:2:12: .*has no field 'volts'"):
         check_source(Source("q.rbs", text), model=model())
+
+
+def test_a_private_topic_is_the_monitors_own_in_the_model():
+    """`~scan` is the default monitor's /rubass/scan (topicnames.py); it was looked up as '/~scan'."""
+    m = SystemModel({"/rubass/scan": "sensor_msgs/LaserScan"}, None, registry())
+    assert m.field("~scan", ("ranges",)).kind == "array"
+    assert m.field("/scan", ("ranges",)) is None

@@ -6,7 +6,7 @@ import json
 import pytest
 
 from rubass.cli import main
-from rubass.replay.names import resolve, spellings
+from rubass.lang.topicnames import resolve, spellings
 
 LIB = "actions:\n  warn: {plugin: log, level: warn}\n"
 SPEC = """import "lib.yaml";
