@@ -27,7 +27,7 @@ def register(sub: "argparse._SubParsersAction[argparse.ArgumentParser]") -> None
 
 def run(args: argparse.Namespace) -> int:
     from ..testing.results import run_file
-    from .bench import measured
+    from .bench import BenchError, measured
     from .evidence import Evidence, ReportError, build_matrix, read_hazards, replay_bag
     from .html import render
 
@@ -39,11 +39,8 @@ def run(args: argparse.Namespace) -> int:
     try:
         hazards = read_hazards(args.hazards) if args.hazards else []
         reaction = measured(args.bench)
-    except ReportError as exc:
+    except (ReportError, BenchError) as exc:
         print(f"rubass report: error: {exc}", file=sys.stderr)
-        return 1
-    except (OSError, ValueError) as exc:
-        print(f"rubass report: error: {args.bench}: {exc}", file=sys.stderr)
         return 1
     results = [run_file(path, args.actions) for path in args.tests]
     for r in results:

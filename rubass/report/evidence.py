@@ -71,24 +71,45 @@ class Evidence:
 
 
 def read_hazards(path: str) -> List[Hazard]:
-    """A risk-assessment table: `hazards: [{id: H1, title: …, severity: …}, …]`."""
+    """A risk-assessment table: `hazards: [{id: H1, title: …, severity: …}, …]`, each id once."""
     try:
         with open(path, encoding="utf-8") as fh:
-            doc = yaml.safe_load(fh)
+            text = fh.read()
+        doc = yaml.safe_load(text)
+        lines = _item_lines(yaml.compose(text))
     except OSError as exc:
         raise ReportError(f"{path}: cannot read: {exc.strerror or exc}") from None
+    except UnicodeDecodeError:
+        raise ReportError(f"{path}: not a text file") from None
     except yaml.YAMLError as exc:
         raise ReportError(f"{path}: not valid YAML: {exc}") from None
     items = doc.get("hazards") if isinstance(doc, dict) else None
     if not isinstance(items, list):
         raise ReportError(f"{path}: expected 'hazards:' with a list of {{id: …, title: …}}")
     out: List[Hazard] = []
+    first: Dict[str, str] = {}
     for i, h in enumerate(items):
+        where = f"{path}:{lines[i]}" if i < len(lines) else path
         if not isinstance(h, dict) or not isinstance(h.get("id"), (str, int)):
-            raise ReportError(f"{path}: hazard {i + 1} needs an id")
+            raise ReportError(f"{where}: hazard {i + 1} needs an id")
+        hid = str(h["id"])
+        if hid in first:
+            raise ReportError(f"{where}: hazard {hid} is given twice; first at {first[hid]} (each id once: "
+                              f"the matrix would not know which row is meant)")
+        first[hid] = where
         details = {str(k): str(v) for k, v in h.items() if k not in ("id", "title")}
-        out.append(Hazard(str(h["id"]), str(h.get("title", "")), details))
+        out.append(Hazard(hid, str(h.get("title", "")), details))
     return out
+
+
+def _item_lines(root: Any) -> List[int]:
+    """The 1-based line of each item of the `hazards:` list, from the composed YAML."""
+    if not isinstance(root, yaml.MappingNode):
+        return []
+    for key, value in root.value:
+        if getattr(key, "value", None) == "hazards" and isinstance(value, yaml.SequenceNode):
+            return [item.start_mark.line + 1 for item in value.value]
+    return []
 
 
 def attrs(owner: Any) -> Dict[str, Sequence[str]]:

@@ -100,3 +100,33 @@ def test_duplicate_id_of_a_rule_and_a_later_entity(tmp_path):
             '@id("X") entity b { rules: q: topic /v.x > 2; }\nif (a.r or b.q) then { stop; }\n')
     (error,) = [line for line in check_errors(text, tmp_path).splitlines() if "duplicate id" in line]
     assert error.startswith(f"{tmp_path}/dupid2.rbs:4:1:") and error.endswith("dupid2.rbs:3:19")
+
+
+@pytest.mark.parametrize("text, why", [
+    ("not json\n", "line 1 is not JSON"),
+    ('{"a":1}\n', "line 1 holds no reaction figures"),
+    ("", "the file is empty"),
+])
+def test_report_with_an_unusable_bench_file_exits_1(spec_path, write, tmp_path, capsys, text, why):
+    bench = write("bench.jsonl", text)
+    out = str(tmp_path / "r.html")
+    assert main(["report", spec_path, "--bench", bench, "-o", out]) == 1
+    err = capsys.readouterr().err
+    assert f"rubass report: error: {bench}: no reaction figures ({why})" in err
+    assert "bench/reaction.py" in err and not os.path.exists(out)
+
+
+def test_report_with_a_bench_file_missing_figures_or_absent(spec_path, write, tmp_path, capsys):
+    bench = write("bench.jsonl", '{"benchmark": "reaction", "rubass": {"max_ms": 3}}\n')
+    assert main(["report", spec_path, "--bench", bench, "-o", str(tmp_path / "r.html")]) == 1
+    assert f"{bench}:1: a reaction needs the numbers max_ms, p99_ms and p50_ms" in capsys.readouterr().err
+    absent = str(tmp_path / "none.jsonl")
+    assert main(["report", spec_path, "--bench", absent, "-o", str(tmp_path / "r.html")]) == 1
+    assert f"{absent}: cannot read: No such file or directory" in capsys.readouterr().err
+
+
+def test_a_hazard_given_twice_in_the_risk_table_is_an_error_with_its_line(spec_path, write, tmp_path, capsys):
+    risk = write("risk.yaml", "hazards:\n  - {id: H1, title: Collision}\n  - id: H2\n    title: Tip-over\n"
+                              "  - {id: H1, title: Again}\n")
+    assert main(["report", spec_path, "--hazards", risk, "-o", str(tmp_path / "r.html")]) == 1
+    assert f"rubass report: error: {risk}:5: hazard H1 is given twice; first at {risk}:2" in capsys.readouterr().err
