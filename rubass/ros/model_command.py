@@ -8,8 +8,9 @@ import os
 import sys
 from typing import Optional, Tuple
 
-from ..lang.modelfile import dump_model, load_model
+from ..lang.modelfile import dump_model, parse_model
 from ..lang.source import SourceSet
+from ..lang.sourcefile import read_source
 from ..lang.std_units import urdf_joint_kinds
 from ..lang.sysmodel import SystemModel
 from .bag import BagError
@@ -58,8 +59,15 @@ def _build_model(args: argparse.Namespace) -> Tuple[Optional[SystemModel], int]:
     path = getattr(args, "model", None)
     if not path:
         return None, 0
+    src, diag = read_source(path, what="system model")
+    if src is None and diag is not None and diag.message.startswith("cannot read"):
+        print(f"rubass: error: {path}: {diag.message}", file=sys.stderr)  # as an unreadable --bag: 2
+        return None, 2
     sources = SourceSet()
-    model, diags = load_model(path, sources)
+    if src is None:  # read, but not text
+        model, diags = None, [diag] if diag else []
+    else:
+        model, diags = parse_model(sources.add(src))
     if model is None:
         for d in diags:
             print(d.render(sources), file=sys.stderr)
