@@ -78,11 +78,12 @@ def render(ev: Evidence) -> str:
     reaction = (f"<b>≤ {ev.reaction.worst_ms:g} ms</b>worst case measured (p99 {ev.reaction.p99_ms:g} ms)"
                 if ev.reaction else "<b>n/a</b>no benchmark figures")
     out.append("<div class='summary'>"
-               f"<div class='card'><b>{len(ev.hazards)}</b>hazards</div>"
+               f"<div class='card'><b>{len(ev.hazards)}</b>hazard{'s' if len(ev.hazards) != 1 else ''}</div>"
                f"<div class='card'><b>{len(spec.rules)} / {len(spec.behaviours)}</b>rules / behaviours</div>"
                f"<div class='card'><b class='{'fail' if failed or errors else 'pass'}'>{passed} passed, {failed} failed"
                f"</b>tests{f', {len(errors)} file(s) could not run' if errors else ''}</div>"
-               f"<div class='card'><b class='{'fail' if gaps else 'pass'}'>{gaps}</b>gaps in the matrix</div>"
+               f"<div class='card'><b class='{'fail' if gaps else 'pass'}'>{gaps}</b>gap{'s' if gaps != 1 else ''} in the matrix"
+               "</div>"
                f"<div class='card'>{reaction}</div></div>")
     out += _matrix(ev), _rules(ev), _behaviours(ev), _tests(ev), _bags(ev)
     out.append("</body></html>")

@@ -130,3 +130,12 @@ def test_a_hazard_given_twice_in_the_risk_table_is_an_error_with_its_line(spec_p
                               "  - {id: H1, title: Again}\n")
     assert main(["report", spec_path, "--hazards", risk, "-o", str(tmp_path / "r.html")]) == 1
     assert f"rubass report: error: {risk}:5: hazard H1 is given twice; first at {risk}:2" in capsys.readouterr().err
+
+
+def test_one_gap_and_one_hazard_are_singular(spec_path, write, tmp_path, capsys):
+    tests = write("e.test.yaml", TEST.format(covers="E-1"))
+    out = str(tmp_path / "r.html")
+    assert main(["report", spec_path, "--tests", tests, "-o", out]) == 0
+    assert "1 gap in the matrix" in capsys.readouterr().out  # base.far: no test
+    html = open(out, encoding="utf-8").read()
+    assert "<b class='fail'>1</b>gap in the matrix" in html and "<b>1</b>hazard</div>" in html
