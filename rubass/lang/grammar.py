@@ -248,6 +248,9 @@ def _loc_token(text: str) -> pp.ParserElement:
     return _action(_lit(text), lambda s, loc, t: [_Op(text, loc)])
 
 
+_STATEMENTS = ("if", "entity", "const", "action", "import")  # the words a top-level statement starts with
+
+
 def _build() -> pp.ParserElement:
     LPAR, RPAR = (pp.Suppress(_lit(c)).setName(f"'{c}'") for c in "()")
     SEMI = _loc_token(";").setName("';'")
@@ -256,7 +259,10 @@ def _build() -> pp.ParserElement:
 
     def keyword_as_name(s: str, loc: int, toks: Any) -> None:
         if toks[0] in KEYWORDS:
-            _fail(s, loc, f"'{toks[0]}' is a keyword and cannot be used as a name")
+            hint = ""
+            if toks[0] in _STATEMENTS and not s[s.rfind("\n", 0, loc) + 1:loc].strip():
+                hint = f" (a statement cannot start inside an entity: is a '}}' missing before this '{toks[0]}'?)"
+            _fail(s, loc, f"'{toks[0]}' is a keyword and cannot be used as a name{hint}")
 
     ident_node = _action(_action(pp.Regex(_IDENT_RE).setName("name"), keyword_as_name), _ident)
 
@@ -384,6 +390,16 @@ def _found(text: str, loc: int) -> str:
     return f"'{m.group(0)}'" if m else "end of file"
 
 
+def _bad_index(text: str, loc: int) -> Optional[str]:
+    """The message for a '[' after a field path that is no index, slice or [*] (None otherwise)."""
+    if not text.startswith("[", loc) or not re.search(rf"\btopic\s+{_GRAPH_RE}{_PATH_RE}\Z", text[max(0, loc - 300):loc]):
+        return None  # only after a topic's field path
+    m = re.match(r"\[[^\]\n]{0,20}\]?", text[loc:])
+    bad = m.group(0) if m else "["
+    return (f"'{bad}' is not an index: write an integer ([0], [-1]), a slice of integers ([0:90], [-90:]) "
+            "or [*] for the whole array")
+
+
 def parse_source(source: Source, fast: bool = True) -> ast.Spec:
     """Parse one source file into a Spec; raises SpecError for a syntax error.
 
@@ -407,7 +423,7 @@ def parse_source(source: Source, fast: bool = True) -> ast.Spec:
         except pp.ParseBaseException as exc:
             msg = exc.msg
             if msg.startswith("Expected "):
-                msg = f"expected {msg[len('Expected '):]}, found {_found(text, exc.loc)}"
+                msg = _bad_index(text, exc.loc) or f"expected {msg[len('Expected '):]}, found {_found(text, exc.loc)}"
             raise _error(source, exc.loc, msg) from None
         except RecursionError:
             loc, depth = _deepest(text)

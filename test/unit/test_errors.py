@@ -201,3 +201,19 @@ def test_articles_and_unit_formulas_read_as_english(write):
     messages = [m for _, _, m in found]
     assert any(m.startswith("duplicate name 'e' (an entity)") for m in messages), messages
     assert "compares a quantity in m*s with a length" in messages, messages
+
+
+@pytest.mark.parametrize("index", ["1.5:2", "", "a", "*:2", "::"])
+def test_a_bad_index_after_a_field_path_says_what_an_index_is(write, index):
+    found = errors(write, HEAD + f"entity e {{ rules: r: min(topic /s.ranges[{index}]) < 1 m; }}\n"
+                                 "if (e.r) then { stop; }\n")
+    assert found == [(3, 41, f"'[{index}]' is not an index: write an integer ([0], [-1]), a slice of integers "
+                             "([0:90], [-90:]) or [*] for the whole array")], found
+
+
+def test_a_missing_brace_before_a_statement_says_so(write):
+    found = errors(write, HEAD + "entity e { rules: r: topic /v.x > 1;\nif (e.r) then { stop; }\n")
+    assert found == [(4, 1, "'if' is a keyword and cannot be used as a name (a statement cannot start inside "
+                            "an entity: is a '}' missing before this 'if'?)")], found
+    found = errors(write, HEAD + "const if = 1;\n")
+    assert found == [(3, 7, "'if' is a keyword and cannot be used as a name")], found
