@@ -147,7 +147,7 @@ def _json_value(v: Any) -> Any:
         return None
     if isinstance(v, float) and not math.isfinite(v):
         return None if math.isnan(v) else v
-    if isinstance(v, (bool, float, str)):
+    if isinstance(v, (bool, int, float, str)):
         return v
     return _ARRAY  # an array: its min/max/len is the reading, not thousands of elements
 
@@ -220,10 +220,20 @@ class Explainer:
                 fn = self._compile(e)
             except Exception:  # a construct this explainer cannot read alone: leave it out
                 continue
+            if isinstance(e, ast.Quant) and e.func == "count":
+                fn = _as_count(fn)
             checked = _checked_label(e)
             out.append((term, checked[1] if checked is not None else _whole_unit(e), fn))
         self._readers[key] = out
         return out
+
+
+def _as_count(read: Callable[[], Any]) -> Callable[[], Any]:
+    """A count as a whole number (the engine holds it as a float)."""
+    def count() -> Any:
+        v = read()
+        return int(v) if isinstance(v, float) and v.is_integer() else v
+    return count
 
 
 def _rule_refs(expr: ast.Expr) -> List[str]:
