@@ -427,6 +427,10 @@ def parse_source(source: Source, fast: bool = True) -> ast.Spec:
             raise _error(source, exc.loc, msg) from None
         except RecursionError:
             loc, depth = _deepest(text)
+            unary = re.search(r"(?:\bnot\b\s*|-\s*){40,}", text)
+            if unary is not None and depth < 40:
+                raise _error(source, unary.start(), "expressions are nested too deeply to parse (a long run of "
+                                                    "'not' or '-' here; two cancel out: remove pairs)") from None
             raise _error(source, loc, f"expressions are nested too deeply to parse ({depth} parentheses "
                                       "deep here; about 50 parse: flatten it, and/or chains of any length "
                                       "need no parentheses)") from None

@@ -217,3 +217,9 @@ def test_a_missing_brace_before_a_statement_says_so(write):
                             "an entity: is a '}' missing before this 'if'?)")], found
     found = errors(write, HEAD + "const if = 1;\n")
     assert found == [(3, 7, "'if' is a keyword and cannot be used as a name")], found
+
+
+def test_a_long_run_of_not_is_named_where_it_starts(write):
+    found = errors(write, HEAD + "entity e { rules: r: " + "not " * 1000 + "topic /v.x > 1; }\nif (e.r) then { stop; }\n")
+    assert found == [(3, 22, "expressions are nested too deeply to parse (a long run of 'not' or '-' here; "
+                             "two cancel out: remove pairs)")], found
