@@ -81,11 +81,13 @@ _Loader.add_constructor(yaml.resolver.BaseResolver.DEFAULT_SEQUENCE_TAG, _sequen
 
 def load(path: str) -> Any:
     """The document of a YAML file, or TestFileError with the place."""
-    try:
-        with open(path, encoding="utf-8") as fh:
-            text = fh.read()
-    except (OSError, UnicodeDecodeError) as exc:
-        raise TestFileError(path, 0, f"cannot read: {getattr(exc, 'strerror', None) or exc}") from None
+    from ..lang.sourcefile import read_source
+
+    src, diag = read_source(path, what="test file")  # a directory, a FIFO, bad bytes: at their line
+    if src is None:
+        raise TestFileError(path, diag.span.line if diag is not None else 0,
+                            diag.message if diag is not None else "cannot read it")
+    text = src.text
     try:
         return yaml.load(text, Loader=_Loader)  # noqa: S506 (a SafeLoader subclass)
     except TestFileError as exc:

@@ -375,3 +375,13 @@ tests:
     assert code == 2 and "my_robot_msgs/Battery is not installed" in err
     code, _, err = run(capsys, write("d.test.yaml", body.replace("voltage: 10.5", "voltag: 10.5")))
     assert code == 2 and "has no field 'voltag'" in err
+
+
+def test_a_test_file_that_is_no_text_names_the_line_of_the_bad_byte(tmp_path):
+    """TESTING.md: errors are FILE:LINE: error: …; bad bytes were reported with Python's codec wording."""
+    path = tmp_path / "bin.test.yaml"
+    path.write_bytes(b"tests:\n  - name: x\n    expect: []  # \xff\n")
+    r = subprocess.run([sys.executable, "-m", "rubass", "test", str(path)], cwd=ROOT, capture_output=True, text=True)
+    assert r.returncode == 2
+    assert f"{path}:3: error: test file is not UTF-8 text: invalid byte 0xff" in r.stderr, r.stderr
+    assert "codec" not in r.stderr
