@@ -124,7 +124,8 @@ _KEYWORD = re.compile(r"\b(?:topic|node)\s+(?=[/A-Za-z_~])")
 def call_text(text: str, start: int) -> Optional[str]:
     """The text of the call written at `start` (a name and its balanced parentheses) on one line,
     without comments or the `topic`/`node` keywords; None when no call stands there."""
-    depth, pieces, last = 0, [], start
+    depth, last = 0, start
+    pieces: List[str] = []
     for m in _CALL_LEX.finditer(text, start):
         tok = m.group(0)
         if tok.startswith("/"):  # a comment
