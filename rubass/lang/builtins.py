@@ -87,9 +87,9 @@ class BuiltinChecks:
         if e.func == "stamp_age":
             model = getattr(self.scope, "model", None)
             has = model.has_stamp(ref.topic) if model is not None else None
-            if has is False:
-                self.error(ref.span, f"stamp_age() needs a message with header.stamp, and the type of "  # type: ignore[attr-defined]
-                                     f"'{ref.topic}' has none")
+            if has is False:  # its value is unknown (§11): legal, but surely not what was meant
+                self.warn(ref.span, f"stamp_age(topic {ref.topic}) is always unknown: the topic's type has no "  # type: ignore[attr-defined]
+                                    "header.stamp (use age() for the time since its last message)")
             return ast.StampAge(ref.topic, span=e.span), num(TIME)
         if e.func == "age":
             return ast.Age(ref.topic, span=e.span), num(TIME)

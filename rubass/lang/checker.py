@@ -169,7 +169,7 @@ class _Checker:
                 uses = self.active_uses.setdefault(key, set())
                 scope = Scope(self.resolver(ent.name.name, key), nodes=nodes, entity=ent.name.name,
                               actions=self.declared_names, active_uses=uses, model=self.model)
-                checked[key] = ExprChecker(scope, self.diags).condition(r.expr, f"rule '{r.name.name}'")
+                checked[key] = ExprChecker(scope, self.diags, self.warnings).condition(r.expr, f"rule '{r.name.name}'")
         return checked
 
     def order(self) -> List[str]:
@@ -277,7 +277,7 @@ class _Checker:
             uses = self.active_uses.setdefault(f"b:{index}", set())
             user = f"b:{index}"
             scope = Scope(self.resolver(None, user), actions=self.declared_names, active_uses=uses, model=self.model)
-            cond = ExprChecker(scope, self.diags).condition(d.cond, "the condition of 'if'")
+            cond = ExprChecker(scope, self.diags, self.warnings).condition(d.cond, "the condition of 'if'")
             bound: List[BoundAction] = []
             for call in d.actions:
                 name = call.name.name

@@ -99,13 +99,16 @@ class CheckedSpec:
     # rules ('entity.rule') and behaviours ('b:N') in one dependency order (§14)
     evaluation: List[str] = field(default_factory=list)
 
-    def field_readers(self) -> Dict[str, Dict[Tuple[ast.PathElem, ...], List[str]]]:
-        """topic -> field path -> who reads it ("rule 'e.r'", "behaviour 2 (line 9)"), for errors."""
+    def field_readers(self, implicit: bool = True) -> Dict[str, Dict[Tuple[ast.PathElem, ...], List[str]]]:
+        """topic -> field path -> who reads it ("rule 'e.r'", "behaviour 2 (line 9)"), for errors.
+
+        implicit=False leaves out the header.stamp that only stamp_age() reads: a type without one
+        makes stamp_age unknown (§11), it is no field error."""
         out: Dict[str, Dict[Tuple[ast.PathElem, ...], List[str]]] = {t: {} for t in self.topics}
         owners = [(f"rule '{r.key}'", r.expr) for r in self.rules] + \
                  [(f"behaviour {b.index} (line {b.span.line})", b.cond) for b in self.behaviours]
         for owner, expr in owners:
-            for topic, path in _read_paths(expr):
+            for topic, path in _read_paths(expr, implicit):
                 users = out[topic].setdefault(path, [])
                 if owner not in users:
                     users.append(owner)
@@ -125,7 +128,7 @@ class CheckedSpec:
         raise KeyError(key)
 
 
-def _read_paths(expr: ast.Expr) -> List[Tuple[str, Tuple[ast.PathElem, ...]]]:
+def _read_paths(expr: ast.Expr, implicit: bool = True) -> List[Tuple[str, Tuple[ast.PathElem, ...]]]:
     """Every (topic, field path) an expression reads; an array term's element paths in full
     (`status[*].level`), so they can be checked against the message type too."""
     out: List[Tuple[str, Tuple[ast.PathElem, ...]]] = []
@@ -134,7 +137,7 @@ def _read_paths(expr: ast.Expr) -> List[Tuple[str, Tuple[ast.PathElem, ...]]]:
             out.append((e.topic, e.path))
         elif isinstance(e, ast.ArrayFn) and e.elem:
             out.append((e.ref.topic, e.ref.path + e.elem))
-        elif isinstance(e, ast.StampAge):  # the message must be read for its stamp
+        elif isinstance(e, ast.StampAge) and implicit:  # the message must be read for its stamp
             out.append((e.topic, ("header", "stamp")))
         elif isinstance(e, ast.Quant):
             out += [(e.ref.topic, e.ref.path + x.path) for x in ast.walk(e.body) if isinstance(x, ast.Elem) and x.path]

@@ -84,12 +84,16 @@ class ExprChecker(BuiltinChecks):
         super().__init_subclass__(**kwargs)
         cls._methods = {}  # a subclass may override a check: a table of its own
 
-    def __init__(self, scope: Scope, diags: List[Diagnostic]) -> None:
+    def __init__(self, scope: Scope, diags: List[Diagnostic], warnings: Optional[List[Diagnostic]] = None) -> None:
         self.scope, self.diags = scope, diags
+        self.warnings: List[Diagnostic] = [] if warnings is None else warnings
         self.quant: Optional[_Quant] = None
 
     def error(self, span: Span, msg: str) -> None:
         self.diags.append(Diagnostic(span, msg))
+
+    def warn(self, span: Span, msg: str) -> None:
+        self.warnings.append(Diagnostic(span, msg, "warning"))
 
     # -- entry points --------------------------------------------------------------------
     def condition(self, expr: ast.Expr, what: str) -> ast.Expr:

@@ -98,7 +98,7 @@ def run(args: argparse.Namespace) -> int:
             print(f"rubass replay: error: {exc}", file=sys.stderr)
             return 1
         errors = []
-        readers = [((t, p), owners) for t, paths in spec.field_readers().items() for p, owners in paths.items()]
+        readers = [((t, p), owners) for t, paths in spec.field_readers(implicit=False).items() for p, owners in paths.items()]
         for (topic, path), owners in sorted(readers, key=str):
             cls = classes.get(resolve(topic))
             problem = check_path(cls, path) if cls is not None else None

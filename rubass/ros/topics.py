@@ -42,6 +42,7 @@ class TopicState:
     paths: Dict[Tuple[ast.PathElem, ...], List[str]]  # field path -> rules reading it
     aliases: Tuple[str, ...] = ()  # other spellings of this topic in the spec ('cmd_vel' beside '/cmd_vel')
     scalar: FrozenSet[Tuple[ast.PathElem, ...]] = frozenset()  # paths the spec uses as one value
+    implicit: FrozenSet[Tuple[ast.PathElem, ...]] = frozenset()  # header.stamp only for stamp_age(): unknown if absent
     type: str = ""
     md5: str = ""
     messages: int = 0
@@ -67,14 +68,16 @@ class TopicWatcher:
             spellings.setdefault(rospy.resolve_name(t), []).append(t)
         wanted = {r: names[0] for r, names in spellings.items()}
         scalar = scalar_paths(spec)
-        readers = spec.field_readers()
+        readers, explicit = spec.field_readers(), spec.field_readers(implicit=False)
         users: Dict[str, Dict[Tuple[ast.PathElem, ...], List[str]]] = {}
+        stamp_only: Dict[str, FrozenSet[Tuple[ast.PathElem, ...]]] = {}  # header.stamp read by stamp_age() only
         for names in spellings.values():
             merged: Dict[Tuple[ast.PathElem, ...], List[str]] = {}
             for n in names:
                 for path, owners in readers[n].items():
                     merged.setdefault(path, []).extend(o for o in owners if o not in merged.get(path, []))
             users[names[0]] = merged
+            stamp_only[names[0]] = frozenset(p for p in merged if not any(p in explicit[n] for n in names))
         with self._lock:
             for resolved in [r for r in self.topics if r not in wanted]:
                 state = self.topics.pop(resolved)
@@ -85,13 +88,13 @@ class TopicWatcher:
                 aliases = tuple(spellings[resolved][1:])
                 used_as_value = frozenset(p for n in spellings[resolved] for p in scalar.get(n, ()))
                 if state is None:
-                    state = TopicState(name, resolved, users[name], aliases, used_as_value)
+                    state = TopicState(name, resolved, users[name], aliases, used_as_value, stamp_only[name])
                     self.topics[resolved] = state
                     state.subscriber = rospy.Subscriber(resolved, rospy.AnyMsg, self._callback,
                                                         callback_args=state, tcp_nodelay=True)
                 else:
                     state.spec_name, state.paths, state.aliases = name, users[name], aliases
-                    state.scalar = used_as_value
+                    state.scalar, state.implicit = used_as_value, stamp_only[name]
                     if state.cls is not None:
                         state.errors = self._check(state)
 
@@ -149,6 +152,8 @@ class TopicWatcher:
     def _check(self, state: TopicState) -> List[str]:
         out = []
         for path, owners in state.paths.items():
+            if path in state.implicit:
+                continue  # stamp_age() of a type without header.stamp is unknown (§11), no field error
             problem = check_path(state.cls, path, path in state.scalar) if state.cls is not None else None
             if problem:
                 out.append(f"{' and '.join(owners)} reads {state.spec_name}{ast.path_suffix(path)}, but in {state.type}: "

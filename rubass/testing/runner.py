@@ -80,7 +80,7 @@ def _stream(spec: CheckedSpec, case: Case, path: str, warnings: List[str]) -> Li
 
     names = spellings(spec.topics)  # resolved -> every spelling of it in the spec, each fed every message
     end = case.end
-    readers = spec.field_readers()
+    readers = spec.field_readers(implicit=False)
     for topic, t in case.topics.items():
         if topic not in names:
             warnings.append(f"{path}:{t.line}: warning: the spec reads no topic {topic}"

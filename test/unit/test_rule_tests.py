@@ -385,3 +385,34 @@ def test_a_test_file_that_is_no_text_names_the_line_of_the_bad_byte(tmp_path):
     assert r.returncode == 2
     assert f"{path}:3: error: test file is not UTF-8 text: invalid byte 0xff" in r.stderr, r.stderr
     assert "codec" not in r.stderr
+
+
+def test_stamp_age_of_a_type_without_a_header_is_unknown_not_an_error(write, capsys):
+    """§11: stamp_age is unknown for a type with no header.stamp. `rubass test` refused the file
+    (exit 2: 'reads /x.header.stamp', a field the user never wrote)."""
+    write("lib.yaml", LIB)
+    write("s.rbs", 'import "lib.yaml";\naction primitive stop, warn;\n'
+                   "entity e { rules:\n  stale: stamp_age(topic /x) > 0.5 s;\n  known: not (stamp_age(topic /x) > 0.5 s);\n"
+                   "  high: topic /x.data > 1;\n}\n"
+                   "if (e.stale or e.known) then { stop; }\nif (e.high) then { warn; }\n")
+    path = write("s.test.yaml", "spec: s.rbs\ntests:\n  - name: unknown\n    duration: 3 s\n    topics:\n"
+                                "      /x: {type: std_msgs/Float64, messages: [{at: 1 s, data: 2}]}\n"
+                                "    expect:\n      - {at: 1 s, start: 2}\n      - {never: 1}\n")
+    code, out, err = run(capsys, path)
+    assert code == 0, out + err
+    assert "PASS" in out and "header.stamp" not in err
+
+
+def test_stamp_age_of_a_type_without_a_header_is_a_warning_with_a_model(tmp_path):
+    from rubass.lang.loader import check_source
+    from rubass.lang.msgdef import Registry, parse_msg
+    from rubass.lang.source import Source
+    from rubass.lang.sysmodel import SystemModel
+
+    registry = Registry()
+    registry.add(parse_msg("std_msgs/Float64", "float64 data\n"))
+    checked = check_source(Source("s.rbs", "entity e { rules: s: stamp_age(topic /x) > 0.5 s; }\n"),
+                           model=SystemModel({"/x": "std_msgs/Float64"}, None, registry))
+    assert [f"{w.span.line}:{w.span.col}: {w.message}" for w in checked.warnings] == [
+        "1:32: stamp_age(topic /x) is always unknown: the topic's type has no header.stamp (use age() for the "
+        "time since its last message)"]
