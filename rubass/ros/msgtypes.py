@@ -6,6 +6,7 @@ import sys
 from typing import Any, Optional, Tuple
 
 from ..lang.ast import PathElem, Slice
+from ..lang.fielduse import CONDITION, NUMBER
 
 _ARRAY = re.compile(r"(.*)\[(\d*)\]$")
 _PRIMITIVES = {"bool", "int8", "uint8", "int16", "uint16", "int32", "uint32", "int64", "uint64",
@@ -30,9 +31,10 @@ def _message_class(type_name: str, near: Any) -> Optional[Any]:
         return None
 
 
-def check_path(cls: Any, path: Tuple[PathElem, ...], scalar: bool = False) -> Optional[str]:
+def check_path(cls: Any, path: Tuple[PathElem, ...], scalar: bool = False, need: Optional[str] = None) -> Optional[str]:
     """None if `path` can exist in messages of class `cls`, else what is wrong with it.
-    scalar: the spec uses the value as a number or truth value (not as min(), max(), len()'s argument)."""
+    scalar: the spec uses the value as a number or truth value (not as min(), max(), len()'s argument);
+    need: 'number' or 'condition' when the spec computes with it or needs it true or false (fielduse.py)."""
     type_name = getattr(cls, "_type", cls.__name__)
     current: Optional[Any] = cls
     slot_type = type_name
@@ -68,4 +70,10 @@ def check_path(cls: Any, path: Tuple[PathElem, ...], scalar: bool = False) -> Op
     if scalar and _ARRAY.match(slot_type):
         return (f"'{done}' is an array ({slot_type}) used as a single value: take min(), max() or len() of it, "
                 f"or index it, e.g. '{done}[0]'")
+    if need == NUMBER and slot_type in ("string", "bool"):
+        return f"'{done}' is a {slot_type}, and the spec uses it as a number: its value would never be known"
+    if need == CONDITION and slot_type in _PRIMITIVES and slot_type != "bool":
+        example = f"{done} == \"…\"" if slot_type == "string" else f"{done} > 0"
+        return (f"'{done}' is a {slot_type}, and the spec uses it as a condition (true or false): compare it, "
+                f"e.g. '{example}'")
     return None

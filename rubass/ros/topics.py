@@ -16,6 +16,7 @@ import rospy
 
 from ..engine.values import UNKNOWN
 from ..lang import ast
+from ..lang.fielduse import field_needs
 from ..lang.model import CheckedSpec
 from .msgtypes import check_path
 
@@ -43,6 +44,7 @@ class TopicState:
     aliases: Tuple[str, ...] = ()  # other spellings of this topic in the spec ('cmd_vel' beside '/cmd_vel')
     scalar: FrozenSet[Tuple[ast.PathElem, ...]] = frozenset()  # paths the spec uses as one value
     implicit: FrozenSet[Tuple[ast.PathElem, ...]] = frozenset()  # header.stamp only for stamp_age(): unknown if absent
+    needs: Dict[Tuple[ast.PathElem, ...], str] = field(default_factory=dict)  # path -> 'number' | 'condition'
     type: str = ""
     md5: str = ""
     messages: int = 0
@@ -68,6 +70,7 @@ class TopicWatcher:
             spellings.setdefault(rospy.resolve_name(t), []).append(t)
         wanted = {r: names[0] for r, names in spellings.items()}
         scalar = scalar_paths(spec)
+        needs = field_needs([r.expr for r in spec.rules] + [b.cond for b in spec.behaviours])
         readers, explicit = spec.field_readers(), spec.field_readers(implicit=False)
         users: Dict[str, Dict[Tuple[ast.PathElem, ...], List[str]]] = {}
         stamp_only: Dict[str, FrozenSet[Tuple[ast.PathElem, ...]]] = {}  # header.stamp read by stamp_age() only
@@ -87,14 +90,15 @@ class TopicWatcher:
                 state = self.topics.get(resolved)
                 aliases = tuple(spellings[resolved][1:])
                 used_as_value = frozenset(p for n in spellings[resolved] for p in scalar.get(n, ()))
+                needed = {p: k for n in reversed(spellings[resolved]) for p, k in needs.get(n, {}).items()}
                 if state is None:
-                    state = TopicState(name, resolved, users[name], aliases, used_as_value, stamp_only[name])
+                    state = TopicState(name, resolved, users[name], aliases, used_as_value, stamp_only[name], needed)
                     self.topics[resolved] = state
                     state.subscriber = rospy.Subscriber(resolved, rospy.AnyMsg, self._callback,
                                                         callback_args=state, tcp_nodelay=True)
                 else:
                     state.spec_name, state.paths, state.aliases = name, users[name], aliases
-                    state.scalar, state.implicit = used_as_value, stamp_only[name]
+                    state.scalar, state.implicit, state.needs = used_as_value, stamp_only[name], needed
                     if state.cls is not None:
                         state.errors = self._check(state)
 
@@ -140,21 +144,21 @@ class TopicWatcher:
         old = state.type
         state.type, state.md5 = header.get("type", "?"), header.get("md5sum", "")
         state.cls = self._class(state.type, state.md5, header.get("message_definition", ""))
-        if old and old != state.type:
-            self.log("error", f"topic {state.resolved} changed type from {old} to {state.type}")
         state.errors = [] if state.cls is not None else [f"cannot load message type {state.type}"]
-        if old and old != state.type:
-            state.errors.append(f"changed type from {old} to {state.type}")
-        state.errors += self._check(state)
+        state.errors += self._check(state)  # what the rules cannot read first: the status shows the first
         for e in state.errors:
             self.log("error", f"topic {state.resolved}: {e}")
+        if old and old != state.type:
+            self.log("error", f"topic {state.resolved} changed type from {old} to {state.type}")
+            state.errors.append(f"changed type from {old} to {state.type}")
 
     def _check(self, state: TopicState) -> List[str]:
         out = []
         for path, owners in state.paths.items():
             if path in state.implicit:
                 continue  # stamp_age() of a type without header.stamp is unknown (§11), no field error
-            problem = check_path(state.cls, path, path in state.scalar) if state.cls is not None else None
+            problem = check_path(state.cls, path, path in state.scalar, state.needs.get(path)) \
+                if state.cls is not None else None
             if problem:
                 out.append(f"{' and '.join(owners)} reads {state.spec_name}{ast.path_suffix(path)}, but in {state.type}: "
                            f"{problem}; its value stays unknown")

@@ -49,3 +49,19 @@ def test_a_missing_field_runs_the_error_actions_until_the_topic_has_it_again(ros
     got = [r["wall"] for r in records(brake) if r["kind"] == "recv"]
     assert got, "the brake ran while the field could not be read"
     assert not [w for w in got if w > released + 0.3], "and stopped once it could"
+
+
+def test_a_string_compared_with_a_number_is_a_data_error_not_a_silent_unknown(ros, tmp_path):
+    """Acceptance finding: `topic /bump.data > 0` on a std_msgs/String stayed unknown with no
+    error, no reason and no ~error_actions."""
+    mon = ros.monitor(spec(tmp_path, "entity a { rules: hit: topic /bump.data > 0; }\nif (a.hit) then { stop; }\n"),
+                      error_actions="brake")
+    rec = ros.probe({"listen": [{"topic": "/brake", "type": "std_msgs/Bool"}],
+                     "advertise": [{"topic": "/bump", "type": "std_msgs/String"}],
+                     "steps": [{"wait_subscribers": "/bump"}, {"wait_publishers": "/brake"}, {"sleep": 0.3},
+                               {"publish": "/bump", "msg": {"data": "5"}}, {"wait": "/brake", "timeout": 3}]})
+    assert first(rec, "recv", "/brake") is not None, ros.log(mon)
+    statuses = diagnostics(ros)
+    entity = next(s for s in statuses if s["name"] == "rubass: a")
+    assert entity["level"] == 2 and "a.hit" in entity["message"] and "is a string" in entity["message"], entity
+    wait_log(mon, ros, "'data' is a string, and the spec uses it as a number")
