@@ -13,6 +13,7 @@ from ..engine import Event
 from ..lang import ast
 from ..lang.attributes import entity_ids, rule_ids
 from ..lang.model import CheckedSpec
+from ..lang.topicnames import spellings
 from ..testing.coverage import Coverage, coverage
 from ..testing.results import FileResult
 from ..testing.runner import Outcome
@@ -196,16 +197,17 @@ def replay_bag(spec: CheckedSpec, path: str, rate: float = 50.0) -> BagRun:
         run.error = str(exc)
         return run
     with bag:
-        names = {(t if t.startswith("/") else "/" + t): t for t in spec.topics}
+        names = spellings(spec.topics)  # bag name -> every spelling of it in the spec, as replay feeds them
         present = [t for t in names if t in info.types]
         run.warnings = [f"topic {t} is not in the recording; its values stay unknown" for t in sorted(names)
                         if t not in info.types]
         strings = [t for t, ty in info.types.items() if ty == "std_msgs/String"] if spec.nodes else []
         node_topics = sorted(t for t in strings if t.endswith("/node_samples"))
         agent_topics = sorted(t for t in strings if t.endswith("/agent_samples"))
-        decode = {t for t in present if spec.topics[names[t]].needs_data} | set(node_topics) | set(agent_topics)
-        stream: Any = ((t, names.get(topic, topic), msg)
-                       for t, topic, msg in read(bag, present + node_topics + agent_topics, decode))
+        decode = {t for t in present if any(spec.topics[n].needs_data for n in names[t])} | set(node_topics) | \
+            set(agent_topics)
+        stream: Any = ((t, name, msg) for t, topic, msg in read(bag, present + node_topics + agent_topics, decode)
+                       for name in names.get(topic, (topic,)))
         try:
             if agent_topics:  # multi-host: the agents' reports, as `rubass replay` reads them
                 from ..replay.agents import SAMPLES, agent_samples

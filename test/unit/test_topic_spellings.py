@@ -137,3 +137,26 @@ tests:
         b.write("/rubass/p", Float64(2.0), rospy.Time.from_sec(100.0))
     code, out, err = run(capsys, "replay", spec, bag)
     assert code == 1 and "reads ~p.dat, but in std_msgs/Float64" in err, out + err
+
+
+def test_the_report_replays_every_spelling_of_a_topic(write, tmp_path):
+    """rubass report --bag replays as rubass replay does: each spelling fed (helper finding)."""
+    rosbag = pytest.importorskip("rosbag")
+    import rospy
+    from std_msgs.msg import Float64
+
+    from rubass.lang import load_spec
+    from rubass.report.evidence import replay_bag
+
+    write("lib.yaml", LIB)
+    spec = load_spec(write("robot.rbs", SPEC))
+    bag = str(tmp_path / "x.bag")
+    with rosbag.Bag(bag, "w") as b:
+        b.write("/x", Float64(0.0), rospy.Time.from_sec(100.0))
+        b.write("/x", Float64(2.0), rospy.Time.from_sec(100.5))
+        b.write("/rubass/p", Float64(2.0), rospy.Time.from_sec(101.0))
+        b.write("/x", Float64(0.0), rospy.Time.from_sec(102.0))
+    run = replay_bag(spec, bag)
+    assert not run.error and not run.warnings, (run.error, run.warnings)
+    starts = sorted((e.behaviour, round(e.time, 3)) for e in run.events if e.kind == "start")
+    assert starts == [(1, 0.5), (2, 0.5), (3, 1.0)]
