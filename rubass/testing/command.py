@@ -5,12 +5,11 @@ Exit 0 when every test passes, 1 when one fails, 2 when a file cannot be run (TE
 from __future__ import annotations
 
 import argparse
-import os
 import sys
 from typing import Dict, List, TextIO
 
 from .coverage import coverage, render
-from .results import FileResult, run_file
+from .results import FileResult, run_file, shown_path
 
 
 def register(sub: "argparse._SubParsersAction[argparse.ArgumentParser]") -> None:
@@ -33,7 +32,7 @@ def print_results(results: List[FileResult], out: TextIO, err: TextIO) -> None:
         if r.error:
             print(r.error, file=err)
             continue
-        print(f"{os.path.relpath(r.path)} (spec {os.path.relpath(r.spec_path)})", file=out)
+        print(f"{shown_path(r.path)} (spec {shown_path(r.spec_path)})", file=out)
         for o in r.outcomes:
             covers = f"  [{', '.join(o.covers)}]" if o.covers else ""
             print(f"  {'PASS' if o.passed else 'FAIL'}  {o.name}{covers}", file=out)

@@ -5,7 +5,7 @@ import os
 import xml.etree.ElementTree as ET
 from typing import List
 
-from .results import FileResult
+from .results import FileResult, shown_path
 
 
 def write_junit(results: List[FileResult], path: str) -> None:
@@ -13,7 +13,7 @@ def write_junit(results: List[FileResult], path: str) -> None:
     root = ET.Element("testsuites", name="rubass test")
     total = failures = errors = 0
     for r in results:
-        name = os.path.relpath(r.path)
+        name = shown_path(r.path)
         suite = ET.SubElement(root, "testsuite", name=name)
         classname = os.path.basename(r.path).replace(".test.yaml", "").replace(".yaml", "")
         n_fail = 0

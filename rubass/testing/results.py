@@ -1,6 +1,7 @@
 """Running test files: each file's spec, its tests' outcomes, or the error that stopped it."""
 from __future__ import annotations
 
+import os
 import time
 from dataclasses import dataclass, field
 from typing import List, Optional, Sequence
@@ -55,3 +56,9 @@ def run_file(path: str, extra_actions: Sequence[str] = ()) -> FileResult:
         outcome.elapsed = time.perf_counter() - t0
         result.outcomes.append(outcome)
     return result
+
+
+def shown_path(path: str) -> str:
+    """A path as the user sees it: relative below the current directory, else absolute."""
+    rel = os.path.relpath(path)
+    return os.path.abspath(path) if rel == ".." or rel.startswith(".." + os.sep) else rel

@@ -416,3 +416,11 @@ def test_stamp_age_of_a_type_without_a_header_is_a_warning_with_a_model(tmp_path
     assert [f"{w.span.line}:{w.span.col}: {w.message}" for w in checked.warnings] == [
         "1:32: stamp_age(topic /x) is always unknown: the topic's type has no header.stamp (use age() for the "
         "time since its last message)"]
+
+
+def test_a_file_outside_the_current_directory_is_shown_by_its_absolute_path(tmp_path):
+    from rubass.testing.results import shown_path
+
+    outside = str(tmp_path / "x.test.yaml")
+    assert shown_path(outside) == outside  # was '../../tmp/…' from the project folder
+    assert shown_path(os.path.join(os.getcwd(), "a", "b.yaml")) == os.path.join("a", "b.yaml")
