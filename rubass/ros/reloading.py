@@ -104,8 +104,9 @@ class Reloading:
                 self.last_reload_error = text.splitlines()[0] if text else "error"
                 if self.spec is None:
                     self.load_error = text
-                rospy.logerr("rubass: reload (%s) rejected, the previous rules keep running:\n%s", reason, text)
-                return False, f"rejected: {text}"
+                kept = "nothing is enforced yet" if self.loop is None else "the previous rules keep running"
+                rospy.logerr("rubass: reload (%s) rejected, %s:\n%s", reason, kept, text)
+                return False, f"rejected, {kept}: {text}"
             built = [r for n, r in runners.items() if self.runners.get(n) is not r]
             try:
                 new_engine = Engine(spec, ros_now())
