@@ -457,8 +457,7 @@ def main(argv: Optional[List[str]] = None) -> int:
         monitor = Monitor(config)
         monitor.setup()
     except (ParamError, ConfigError) as exc:
-        rospy.logfatal("rubass: cannot start:\n%s", exc)
-        print(f"rubass monitor: cannot start:\n{exc}", file=sys.stderr)
+        rospy.logfatal("rubass: cannot start:\n%s", exc)  # on stderr and in rosout: printed once
         rospy.signal_shutdown("cannot start")
         return 1
     monitor.run()
