@@ -13,7 +13,7 @@ from .errors import Diagnostic, a_noun, did_you_mean
 from .grammar import KEYWORDS
 from .source import Source, SourceSet, Span
 from .units import FREQUENCY, SPEED, TIME, Dimension, dim, dimension_name, parse_quantity
-from .yamltags import foreign_tags, plain_value
+from .yamltags import foreign_tags, plain_value, resolve_merges
 
 BUILTIN_PLUGINS = ("publish", "serial", "service", "log", "limit")
 CUSTOM_PLUGIN_RE = re.compile(r"[A-Za-z_][A-Za-z0-9_]*(?:\.[A-Za-z_][A-Za-z0-9_]*)*:[A-Za-z_][A-Za-z0-9_]*")
@@ -254,6 +254,13 @@ def parse_library(src: Source) -> Tuple[Dict[str, ActionDef], List[Diagnostic]]:
         return {}, [Diagnostic(_Node(n, src.name).span, f"YAML tag '{n.tag}' is not allowed: an action library "
                                                         f"holds plain data only (strings, numbers, booleans, "
                                                         f"lists, mappings)") for n in foreign]
+    try:
+        bad_merges = resolve_merges(root)  # `<<: *base` shares keys between actions
+    except RecursionError:
+        return {}, [Diagnostic(top, "YAML merge keys ('<<') are nested too deeply")]
+    if bad_merges:
+        return {}, [Diagnostic(_Node(n, src.name).span, "a merge key '<<' takes a mapping (such as '*base') or a "
+                                                        "list of them") for n in bad_merges]
     entries = {_key(k): (k, v) for k, v in root.value}
     if "actions" not in entries:
         return {}, [Diagnostic(top, "an action library needs a top-level key 'actions'")]

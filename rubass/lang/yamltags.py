@@ -2,7 +2,7 @@
 custom '!tags'), so that a file is reported as an error rather than a loader traceback."""
 from __future__ import annotations
 
-from typing import AbstractSet, Any, List
+from typing import AbstractSet, Any, List, Set
 
 import yaml
 
@@ -37,3 +37,59 @@ def plain_value(node: yaml.Node) -> Any:
         return loader.construct_object(node, deep=True)
     finally:
         loader.dispose()
+
+
+MERGE = _CORE + "merge"
+
+
+def resolve_merges(root: yaml.Node) -> List[yaml.Node]:
+    """Apply YAML merge keys (`<<: *base`, `<<: [*a, *b]`) in place, in every mapping of a
+    composed document; the nodes of merge keys whose value is no mapping (or list of them).
+
+    A key written in the mapping wins over a merged one, and an earlier merged mapping over a
+    later one, as YAML says. Each mapping is merged once and its keys are kept once, so a file
+    of aliases that merge each other many times (an alias bomb) stays as small as its text.
+    """
+    bad: List[yaml.Node] = []
+    done: Set[int] = set()
+
+    def merge(node: yaml.MappingNode) -> None:
+        if id(node) in done:
+            return
+        done.add(id(node))
+        own: List[Any] = []
+        merged: List[Any] = []
+        for key, value in node.value:
+            if key.tag != MERGE:
+                own.append((key, value))
+                continue
+            sources = value.value if isinstance(value, yaml.SequenceNode) else [value]
+            for src in sources:
+                if not isinstance(src, yaml.MappingNode):
+                    bad.append(value)
+                    break
+                merge(src)
+                merged += src.value
+        if not merged:
+            node.value = own
+            return
+        seen = {k.value for k, _ in own if isinstance(k, yaml.ScalarNode)}
+        for key, value in merged:
+            name = key.value if isinstance(key, yaml.ScalarNode) else None
+            if name is None or name not in seen:
+                seen.add(name)
+                own.append((key, value))
+        node.value = own
+
+    todo, visited = [root], set()
+    while todo:
+        node = todo.pop()
+        if id(node) in visited:
+            continue
+        visited.add(id(node))
+        if isinstance(node, yaml.MappingNode):
+            merge(node)
+            todo += [n for pair in node.value for n in pair]
+        elif isinstance(node, yaml.SequenceNode):
+            todo += list(node.value)
+    return bad

@@ -163,3 +163,26 @@ def test_check_reports_one_priority_on_one_topic_across_two_libraries(tmp_path):
     assert text.startswith(f"{tmp_path}/b.yaml:3:3: error: action 'brake': same priority (0) as action 'stop' "
                            f"({tmp_path}/a.yaml:2:3), and both publish on /cmd"), text
     assert len(info.value.diagnostics) == 1  # slow (priority 1) is fine, and brake is not also "undefined"
+
+
+def test_yaml_merge_keys_share_settings_between_actions():
+    """`<<: *base` (acceptance finding: it gave "missing key 'plugin'"); own keys win over merged ones."""
+    actions, diags = lib("actions:\n  stop: &pub\n" + PUB + "    topic: /cmd_vel_safety\n    priority: 2\n"
+                         "  brake:\n    <<: *pub\n    topic: /brake\n    priority: 3\n"
+                         "  halt: {<<: [*pub], topic: /halt}\n")
+    assert diags == []
+    assert [(actions[n].priority, actions[n].plugin) for n in ("stop", "brake", "halt")] == \
+        [(2, "publish"), (3, "publish"), (2, "publish")]
+
+
+def test_a_merge_key_of_a_scalar_is_an_error_at_its_place():
+    assert errors("actions:\n  stop:\n    <<: 3\n" + PUB + "    topic: /a\n") == [
+        (3, "a merge key '<<' takes a mapping (such as '*base') or a list of them")]
+
+
+def test_merge_keys_that_merge_each_other_stay_small():
+    """An alias bomb of merges: each mapping is merged once, its keys kept once."""
+    text = "a0: &a0 {k: 1}\n" + "".join(f"a{i}: &a{i} {{<<: [*a{i - 1}, *a{i - 1}], k{i}: {i}}}\n"
+                                          for i in range(1, 60)) + "actions:\n  stop:\n    <<: *a59\n"
+    _, diags = lib(text)
+    assert any("unknown top-level key 'a0'" in m for _, m in diags)  # reported, in no time or memory
