@@ -216,6 +216,15 @@ def test_a_serial_board_that_vanishes_and_comes_back_gets_the_stop_it_missed(ros
     back = time.time()
     assert read_until(master, b"S\n") == b"S\n", ros.log(mon)
     assert time.time() - back < 0.5 + 0.3, "reopened within a reopen period"
+    assert read_until(master, b"never", timeout=1.5) == b"", "the missed start is written once, not twice"
+    # unplugged while its stop is active: the board that comes back lost its state, so it gets it again
+    os.close(master)
+    os.close(slave)
+    (tmp_path / "ttyBOARD").unlink()
+    time.sleep(1.5)
+    master, slave = new_board()
+    assert read_until(master, b"S\n", timeout=3) == b"S\n", ros.log(mon)
+    wait_log(mon, ros, "is back: start written again")
     os.close(master)
     os.close(slave)
 

@@ -1,10 +1,12 @@
 """The `serial` plugin (pyserial): bytes on start, hold and release; the port is reopened after
-the device vanishes, and a start that could not be written is written when it comes back."""
+the device vanishes, and while the action is active its start is written again on every reopen
+(a board that was away lost its state, whether or not it had the start before)."""
 from __future__ import annotations
 
 import threading
 from typing import Any, Optional
 
+import rospy
 import serial
 
 from ...actions.base import ActionPlugin, Context
@@ -22,7 +24,7 @@ class SerialPlugin(ActionPlugin):
     def __init__(self, action: Any) -> None:
         super().__init__(action)
         self.port: Optional[serial.SerialBase] = None
-        self.pending: Optional[bytes] = None  # start bytes owed to a device that was away
+        self.started = False  # the start bytes reached the port open now (reset when it closes)
         self.lock = threading.Lock()
         self.state = "closed"
 
@@ -34,6 +36,7 @@ class SerialPlugin(ActionPlugin):
             self.port = serial.serial_for_url(self.params["port"], baudrate=self.params["baud"], timeout=0,
                                               write_timeout=self.params["write_timeout"])
             self.state = "open"
+            self.started = False  # a new connection: the device knows nothing of earlier writes
             return True
         except (serial.SerialException, OSError, ValueError) as exc:
             self.port = None
@@ -61,37 +64,36 @@ class SerialPlugin(ActionPlugin):
         except (serial.SerialException, OSError):
             pass
         self.port = None
+        self.started = False
         self.state = why
 
     def start(self, ctx: Context) -> None:
-        data = _bytes(self.params.get("on_start"))
-        try:
-            self._write(data)
-            self.pending = None
-        except IOError:
-            self.pending = data
-            raise
+        if self.started:  # periodic() wrote it already when the port came back: once, not twice
+            return
+        self._write(_bytes(self.params.get("on_start")))
+        self.started = self.port is not None
 
     def hold(self, ctx: Context) -> None:
         self._write(_bytes(self.params.get("on_hold")))
 
     def release(self, ctx: Context) -> None:
-        self.pending = None
+        self.started = False
         self._write(_bytes(self.params.get("on_release")))
 
     def periodic(self) -> None:
-        """Reopen a vanished device; deliver a start it missed while the action is still active."""
+        """Reopen a vanished device; while the action is active, write its start again to it."""
         with self.lock:
-            if self.port is None:
-                self._open()
-            elif not self._alive():
+            reopened = self.port is None and self._open()
+            if not reopened and self.port is not None and not self._alive():
                 self._drop("the device went away")
-        if self.port is not None and self.pending and self.active:
+        data = _bytes(self.params.get("on_start"))
+        if reopened and self.active and data and not self.started:
             try:
-                self._write(self.pending)
-                self.pending = None
+                self._write(data)
             except IOError:
-                pass
+                return  # dropped again: the next period reopens and tries again
+            self.started = True
+            rospy.logwarn(f"action '{self.name}': serial board {self.params['port']} is back: start written again")
 
     def _alive(self) -> bool:
         """A pty or USB device that vanished shows as EIO/EOF on a non-blocking read."""
