@@ -66,7 +66,7 @@ from .clockjump import ClockJump
 from ..actions.errorguard import ErrorGuard
 from ..actions.keeper import LatchKeeper
 from ..actions.latches import LatchFile, default_path
-from .params import MonitorConfig, ParamError, read_config
+from .params import MonitorConfig, ParamError, read_config, unknown_params
 from .gcfreeze import freeze_heap
 from .timerslack import exact_timers
 from .reloading import ConfigError, Reloading, StartupError
@@ -451,6 +451,12 @@ class Monitor(Reloading):
 def main(argv: Optional[List[str]] = None) -> int:
     rospy.init_node("rubass", argv=argv, disable_signals=True)  # Monitor handles SIGINT/SIGTERM
     sys.setswitchinterval(0.0005)  # a busy thread must not delay a deadline by the default 5 ms
+    try:
+        names = rospy.get_param_names()
+    except Exception:  # noqa: BLE001 - only a warning is lost; read_config says what is wrong
+        names = []
+    for warning in unknown_params(names, rospy.get_name()):  # a typo must not pass silently
+        rospy.logwarn("rubass: %s", warning)
     try:
         config = read_config(lambda name, default: rospy.get_param("~" + name, default),
                              default_path(os.environ.get("ROS_HOME"), rospy.get_name()))

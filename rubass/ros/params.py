@@ -5,7 +5,7 @@ import os
 from dataclasses import dataclass, field
 from typing import Any, Callable, List, Optional
 
-from ..lang.errors import RubassError
+from ..lang.errors import RubassError, did_you_mean
 from ..lang.units import FREQUENCY, parse_quantity
 
 Getter = Callable[[str, Any], Any]
@@ -28,6 +28,18 @@ class MonitorConfig:
     queue_size: int = 100000  # messages the engine's queue holds
     state_file: Optional[str] = None  # latched actions kept across restarts; None: off
     error_actions: List[str] = field(default_factory=list)  # run while a field cannot be read
+
+
+KNOWN = ("spec", "actions", "rate", "node_rate", "diagnostics_rate", "master_rate", "overload_actions",
+         "queue_size", "error_actions", "state_file")
+
+
+def unknown_params(names: List[str], node: str) -> List[str]:
+    """A warning for each private parameter of `node` (full names from the master) that the monitor
+    does not read (a typo such as `_rat:=5` would otherwise be silently ignored)."""
+    prefix = node.rstrip("/") + "/"
+    found = sorted({n[len(prefix):].split("/")[0] for n in names if n.startswith(prefix)} - set(KNOWN) - {""})
+    return [f"unknown parameter ~{n} (ignored){did_you_mean('~' + n, ['~' + k for k in KNOWN])}" for n in found]
 
 
 def read_rate(get: Getter, name: str, default: float, lo: float, hi: float) -> float:

@@ -1,0 +1,16 @@
+"""A typo in a private parameter of the monitor is warned at start, with a suggestion."""
+import pytest
+
+from rosharness import spec, wait_log
+
+pytestmark = pytest.mark.ros
+
+
+def test_unknown_private_parameters_are_warned_with_a_suggestion(ros, tmp_path):
+    mon = ros.monitor(spec(tmp_path, "entity a { rules: r: topic /x.data > 1; }\nif (a.r) then { stop; }\n"),
+                      rat=5, overload_action="[stop]")
+    wait_log(mon, ros, "enforcing")
+    log = ros.log(mon)
+    assert "unknown parameter ~rat (ignored); did you mean '~rate'?" in log, log
+    assert "unknown parameter ~overload_action (ignored); did you mean '~overload_actions'?" in log, log
+    assert "~spec (ignored)" not in log and "unknown parameter ~queue_size" not in log, log

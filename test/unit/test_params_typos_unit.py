@@ -1,0 +1,17 @@
+"""Private parameters of the monitor that it does not read are named, with a suggestion."""
+from rubass.ros.params import KNOWN, unknown_params
+
+
+def test_a_typo_gets_a_did_you_mean_and_known_or_foreign_names_are_quiet():
+    names = ["/rubass/rat", "/rubass/spec", "/rubass/overload_action", "/rubass/extra/deep", "/rubassx/rat",
+             "/use_sim_time", "/other/rat"] + [f"/rubass/{k}" for k in KNOWN]
+    assert unknown_params(names, "/rubass") == [
+        "unknown parameter ~extra (ignored)",
+        "unknown parameter ~overload_action (ignored); did you mean '~overload_actions'?",
+        "unknown parameter ~rat (ignored); did you mean '~rate'?",
+    ]
+
+
+def test_a_namespaced_node_reads_its_own_names():
+    assert unknown_params(["/robot1/safety/sepc", "/robot1/safety/spec"], "/robot1/safety") == [
+        "unknown parameter ~sepc (ignored); did you mean '~spec'?"]
