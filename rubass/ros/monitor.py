@@ -66,7 +66,7 @@ from .clockjump import ClockJump
 from ..actions.errorguard import ErrorGuard
 from ..actions.keeper import LatchKeeper
 from ..actions.latches import LatchFile, default_path
-from .params import MonitorConfig, ParamError, read_config, unknown_params
+from .params import MonitorConfig, ParamError, read_config, spec_warnings, unknown_params
 from .gcfreeze import freeze_heap
 from .timerslack import exact_timers
 from .reloading import ConfigError, Reloading, StartupError
@@ -107,7 +107,7 @@ class Monitor(Reloading):
         self._check_overload_actions(spec)
         self._check_priorities(spec)
         self._check_library_types(spec)
-        for w in spec.warnings:
+        for w in spec_warnings(spec.warnings, self.config):
             rospy.logwarn("rubass: %s", w.render(spec.sources))
         return spec, self._runners(spec, {})
 

@@ -2,10 +2,11 @@
 from __future__ import annotations
 
 import os
+import re
 from dataclasses import dataclass, field
 from typing import Any, Callable, List, Optional
 
-from ..lang.errors import RubassError, did_you_mean
+from ..lang.errors import Diagnostic, RubassError, did_you_mean
 from ..lang.units import FREQUENCY, parse_quantity
 
 Getter = Callable[[str, Any], Any]
@@ -103,3 +104,18 @@ def read_config(get: Getter, default_state_file: Optional[str] = None) -> Monito
         state_file=_state_file(get, default_state_file),
         error_actions=error_actions,
     )
+
+
+_UNUSED = re.compile(r"action '([^']+)' is declared but never used")
+
+
+def spec_warnings(warnings: List[Diagnostic], config: MonitorConfig) -> List[Diagnostic]:
+    """The spec's warnings that hold for the monitor: an action that only ~overload_actions or
+    ~error_actions names is used (by them), not 'declared but never used'."""
+    used = set(config.overload_actions) | set(config.error_actions)
+    out = []
+    for w in warnings:
+        m = _UNUSED.fullmatch(w.message)
+        if not (m and m.group(1) in used):
+            out.append(w)
+    return out
