@@ -11,6 +11,7 @@ import time
 from typing import Any, Callable, Deque, Dict, Optional, Set, Tuple
 
 from .base import ActionPlugin, ActionStats, Context
+from .status import RESOLVED
 
 Log = Callable[[str, str], None]  # (level, text)
 BACKOFF = (0.05, 0.1, 0.2, 0.5, 1.0)
@@ -204,4 +205,14 @@ class ActionRunner:
             return False
         if what != "periodic":
             self.stats.calls += 1
+        self._resolve(what)
         return True
+
+    def _resolve(self, what: str) -> None:
+        """A success after a failure: the error stays on record but no longer makes /diagnostics ERROR.
+        A periodic success says nothing of a start, hold or release that failed."""
+        error = self.stats.last_error
+        if error and not error.startswith(RESOLVED) and (what != "periodic" or error.startswith("periodic:")):
+            self.stats.last_error = RESOLVED + error
+            if not error.startswith("input:"):  # a plugin's own bad-input count is logged by the plugin
+                self.log("info", f"action '{self.plugin.name}' {what} succeeded after failing ({error})")

@@ -11,6 +11,8 @@ from ..lang import ast
 from ..lang.model import CheckedSpec
 
 OK, WARN, ERROR = 0, 1, 2  # DiagnosticStatus levels
+# an action's last error once a later attempt succeeded: kept for the record, no longer an ERROR
+RESOLVED = "resolved (a later attempt succeeded); was: "
 # node references: NodeRef (version 1), NodeStat (alive/cpu/memory in version 2 of the language)
 _NODE_REFS = tuple(getattr(ast, n) for n in ("NodeRef", "NodeStat") if hasattr(ast, n))
 
@@ -82,7 +84,8 @@ def build(spec: CheckedSpec, rules: Dict[str, Any], active: List[int], topics: D
         out.append(Entry(f"rubass: {entity}", level, msg, values))
     mvalues = [(k, str(v)) for k, v in monitor.items()]
     mvalues.append(("active behaviours", ", ".join(str(i) for i in active) or "none"))
-    level = ERROR if monitor.get("last reload error") or monitor.get("action failures") else OK
+    failing = failing_actions(monitor)  # "action failures" counts every failure ever: only a record
+    level = ERROR if monitor.get("last reload error") or failing else OK
     if monitor.get("latch state error"):  # a latched stop may not survive a restart, or one was restored blind
         level = ERROR
         msg_latch = f" (latch state: {monitor['latch state error']})"
@@ -103,9 +106,19 @@ def build(spec: CheckedSpec, rules: Dict[str, Any], active: List[int], topics: D
         msg += f" (agent silent: {monitor['silent agents']})"
     if monitor.get("last reload error"):
         msg += " (the last reload was rejected; the previous rules still run)"
+    if failing:
+        msg += " (ACTION FAILING: " + "; ".join(f"{name}: {error}" for name, error in failing) + ")"
     msg += msg_latch
     out.append(Entry("rubass: monitor", level, msg, mvalues))
     return out
+
+
+def failing_actions(monitor: Dict[str, Any]) -> List[Tuple[str, str]]:
+    """(name, error) of the actions whose latest attempt failed: the monitor's "action NAME" values
+    that a later success has not marked RESOLVED."""
+    return [(key[len("action "):], value) for key, value in monitor.items()
+            if key.startswith("action ") and key != "action failures" and isinstance(value, str) and value
+            and not value.startswith(RESOLVED)]
 
 
 def not_enforcing(spec_path: str, error: str, reloads: int, rejected: int) -> List[Entry]:

@@ -168,9 +168,17 @@ def test_a_stop_topic_without_subscriber_is_logged_retried_and_reaches_a_late_su
     wait_log(mon, ros, "no node subscribes to /safety_cmd: the message reached no one")
     # the stop is latched: a base controller that subscribes now still gets it
     late = ros.probe({"listen": [{"topic": "/safety_cmd", "type": TWIST}], "steps": [{"mark": "up"},
-                      {"wait": "/safety_cmd", "timeout": 5}]})
+                      {"wait": "/safety_cmd", "timeout": 5}, {"sleep": 2.5}]})  # stays: the retry succeeds
     up, stop = next(r for r in late if r["kind"] == "mark"), first(late, "recv", "/safety_cmd")
     assert stop is not None and stop["wall"] - up["wall"] < 1.5, late  # connection + one period (1/20 s)
+    # the failure is over: /diagnostics is OK again, the failure kept on record (it stayed ERROR for good)
+    wait_log(mon, ros, "action 'stop' start succeeded after failing")
+    rec = ros.probe({"listen": [{"topic": "/diagnostics", "type": "diagnostic_msgs/DiagnosticArray"}],
+                     "steps": [{"sleep": 2.5}]})
+    last = [s for r in rec if r["kind"] == "recv" for s in r["msg"]["status"] if s["name"] == "rubass: monitor"][-1]
+    values = {kv["key"]: kv["value"] for kv in last["values"]}
+    assert last["level"] in (0, b"\x00"), last
+    assert int(values["action failures"]) >= 1 and values["action stop"].startswith("resolved"), values
 
 
 def test_a_serial_board_that_vanishes_and_comes_back_gets_the_stop_it_missed(ros, tmp_path):

@@ -158,3 +158,36 @@ def test_a_bug_in_the_runner_itself_is_logged_and_the_action_goes_on():
         assert any("its runner failed" in t for t in logs) and r.stats.failures == 1
     finally:
         r.stop()
+
+
+def test_a_failure_is_marked_resolved_by_the_next_success_and_the_monitor_is_ok_again():
+    """Issue: /diagnostics stayed ERROR for good after one brief failure (the cumulative count)."""
+    from rubass.actions import status
+    from rubass.lang import check_text
+
+    logs = []
+    p = AlwaysFails(period=0.05)
+    r = ActionRunner(p, lambda level, text: logs.append(text))
+    r.start_thread()
+
+    def monitor_level():
+        spec = check_text("entity base { rules: fast: topic /cmd_vel.linear.x > 1; }\n")
+        monitor = {"action failures": r.stats.failures, "action stop": r.stats.last_error}
+        return status.build(spec, {"base.fast": False}, [], {}, {}, {}, monitor)[-1].level
+
+    try:
+        r.submit("start", Context(1, 3))
+        end = time.monotonic() + 3
+        while not r.stats.failures and time.monotonic() < end:
+            time.sleep(0.01)
+        time.sleep(0.2)  # periodic successes meanwhile do not resolve a failed start
+        assert r.stats.last_error.startswith("start: ") and monitor_level() == status.ERROR
+        p.fail = False  # a subscriber came: the next retry succeeds
+        end = time.monotonic() + 3
+        while r.stats.last_error.startswith("start: ") and time.monotonic() < end:
+            time.sleep(0.01)
+        assert r.stats.last_error == status.RESOLVED + "start: OSError: no node subscribes to /safety_cmd"
+        assert r.stats.failures >= 1 and monitor_level() == status.OK
+        assert any("start succeeded after failing" in t for t in logs), logs
+    finally:
+        r.stop()

@@ -29,3 +29,14 @@ def test_a_rejected_reload_stays_error_whatever_the_master():
 def test_an_overloaded_monitor_is_error_and_names_the_fail_safe_actions():
     e = monitor_entry(master="connected", overloaded="running stop")
     assert e.level == status.ERROR and "OVERLOADED, dropping messages: running stop" in e.message
+
+
+def test_an_action_failure_is_error_only_until_a_later_attempt_succeeds():
+    """A stop that reached no subscriber once, then did: the count stays on record, the level is OK."""
+    failing = monitor_entry(**{"action failures": 3, "action stop2": "start: OSError: no node subscribes to /x"})
+    assert failing.level == status.ERROR
+    assert "ACTION FAILING: stop2: start: OSError: no node subscribes to /x" in failing.message
+    resolved = monitor_entry(**{"action failures": 3,
+                                "action stop2": status.RESOLVED + "start: OSError: no node subscribes to /x"})
+    assert resolved.level == status.OK and "FAILING" not in resolved.message
+    assert ("action failures", "3") in resolved.values
