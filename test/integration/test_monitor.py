@@ -266,11 +266,13 @@ def test_reset_releases_a_latched_stop_once_its_cause_is_gone(ros, tmp_path):
 
 def test_service_action_calls_the_service_and_a_hung_one_times_out_without_blocking(ros, tmp_path):
     lib = LIB + ("  brake_srv: {plugin: service, service: /base/brake, type: std_srvs/Trigger, timeout: 0.3 s}\n"
-                 "  hung_srv: {plugin: service, service: /base/hung, type: std_srvs/Trigger, timeout: 0.3 s}\n")
+                 "  hung_srv: {plugin: service, service: /base/hung, type: std_srvs/Trigger, timeout: 0.3 s}\n"
+                 "  missing_srv: {plugin: service, service: /base/missing, type: std_srvs/Trigger, timeout: 0.3 s}\n")
     (tmp_path / "lib.yaml").write_text(lib)
     path = tmp_path / "s.rbs"
-    path.write_text('import "lib.yaml";\naction primitive brake_srv, hung_srv, brake;\n'
-                    "entity a { rules: r: topic /x.data > 1; }\nif (a.r) then { hung_srv; brake_srv; brake; }\n")
+    path.write_text('import "lib.yaml";\naction primitive brake_srv, hung_srv, missing_srv, brake;\n'
+                    "entity a { rules: r: topic /x.data > 1; }\n"
+                    "if (a.r) then { hung_srv; brake_srv; missing_srv; brake; }\n")
     mon = ros.monitor(str(path))
     rec = ros.probe({"serve": [{"service": "/base/brake", "type": "std_srvs/Trigger"},
                                {"service": "/base/hung", "type": "std_srvs/Trigger", "delay": 30}],
@@ -285,6 +287,9 @@ def test_service_action_calls_the_service_and_a_hung_one_times_out_without_block
     brake = next(r["wall"] for r in rec if r["kind"] == "recv")
     assert brake - sent < 0.1, "the hung service did not delay the other actions"
     assert "action 'hung_srv' start failed" in ros.log(mon) and "did not answer within 0.3 s" in ros.log(mon)
+    # a service nobody advertises is not a timeout: it says so (it said "did not answer within 0.3 s")
+    assert "service /base/missing does not exist (not advertised on the master)" in ros.log(mon), ros.log(mon)
+    assert "/base/missing did not answer" not in ros.log(mon)
 
 
 def test_a_node_hung_with_sigstop_is_not_alive_within_a_sample_and_its_timeout(ros, tmp_path):

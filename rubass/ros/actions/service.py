@@ -4,6 +4,7 @@ from __future__ import annotations
 import threading
 from typing import Any, List
 
+import rosgraph
 import roslib.message
 import rospy
 
@@ -25,6 +26,10 @@ class ServicePlugin(ActionPlugin):
 
         def call() -> None:
             try:
+                if not self._advertised():  # no use waiting: say so at once (the runner retries)
+                    result.append(LookupError(f"service {self.params['service']} does not exist (not advertised "
+                                              f"on the master)"))
+                    return
                 self.proxy.wait_for_service(timeout)
                 result.append(self.proxy.call(self.request))
             except Exception as exc:  # rospy.ServiceException, ROSException, ROSInterruptException
@@ -35,8 +40,20 @@ class ServicePlugin(ActionPlugin):
         worker.join(timeout)
         if not result:
             raise TimeoutError(f"service {self.params['service']} did not answer within {timeout:g} s")
+        if isinstance(result[0], LookupError):
+            raise IOError(str(result[0]))
         if isinstance(result[0], Exception):
             raise IOError(f"service {self.params['service']}: {result[0]}")
+
+    def _advertised(self) -> bool:
+        """Whether the master knows the service; True when the master cannot say (then the call tries)."""
+        try:
+            rosgraph.Master(rospy.get_name()).lookupService(self.proxy.resolved_name)
+            return True
+        except rosgraph.MasterError:  # the master answered: no such service
+            return False
+        except Exception:  # master unreachable or hung: the call's own timeout tells
+            return True
 
     def start(self, ctx: Context) -> None:
         if "start" in self.params["call_on"]:
