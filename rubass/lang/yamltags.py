@@ -52,35 +52,6 @@ def resolve_merges(root: yaml.Node) -> List[yaml.Node]:
     """
     bad: List[yaml.Node] = []
     done: Set[int] = set()
-
-    def merge(node: yaml.MappingNode) -> None:
-        if id(node) in done:
-            return
-        done.add(id(node))
-        own: List[Any] = []
-        merged: List[Any] = []
-        for key, value in node.value:
-            if key.tag != MERGE:
-                own.append((key, value))
-                continue
-            sources = value.value if isinstance(value, yaml.SequenceNode) else [value]
-            for src in sources:
-                if not isinstance(src, yaml.MappingNode):
-                    bad.append(value)
-                    break
-                merge(src)
-                merged += src.value
-        if not merged:
-            node.value = own
-            return
-        seen = {k.value for k, _ in own if isinstance(k, yaml.ScalarNode)}
-        for key, value in merged:
-            name = key.value if isinstance(key, yaml.ScalarNode) else None
-            if name is None or name not in seen:
-                seen.add(name)
-                own.append((key, value))
-        node.value = own
-
     todo, visited = [root], set()
     while todo:
         node = todo.pop()
@@ -88,8 +59,36 @@ def resolve_merges(root: yaml.Node) -> List[yaml.Node]:
             continue
         visited.add(id(node))
         if isinstance(node, yaml.MappingNode):
-            merge(node)
+            _merge(node, done, bad)
             todo += [n for pair in node.value for n in pair]
         elif isinstance(node, yaml.SequenceNode):
             todo += list(node.value)
     return bad
+
+
+def _merge(node: yaml.MappingNode, done: Set[int], bad: List[yaml.Node]) -> None:
+    """resolve_merges for one mapping, its merged mappings first (a module function: a nested
+    recursive one would be a reference cycle, garbage at every reload)."""
+    if id(node) in done:
+        return
+    done.add(id(node))
+    own: List[Any] = []
+    merged: List[Any] = []
+    for key, value in node.value:
+        if key.tag != MERGE:
+            own.append((key, value))
+            continue
+        sources = value.value if isinstance(value, yaml.SequenceNode) else [value]
+        for src in sources:
+            if not isinstance(src, yaml.MappingNode):
+                bad.append(value)
+                break
+            _merge(src, done, bad)
+            merged += src.value
+    seen = {k.value for k, _ in own if isinstance(k, yaml.ScalarNode)}
+    for key, value in merged:
+        name = key.value if isinstance(key, yaml.ScalarNode) else None
+        if name is None or name not in seen:
+            seen.add(name)
+            own.append((key, value))
+    node.value = own
