@@ -6,12 +6,15 @@ import importlib
 import importlib.util
 import inspect
 import os
+import re
 import sys
 import sysconfig
 from dataclasses import dataclass, field
 from typing import Any, Dict, List, Optional, Tuple
 
+from ..lang.errors import Diagnostic
 from ..lang.library import ActionDef
+from ..lang.source import Span
 
 
 class ActionSetupError(Exception):
@@ -98,31 +101,44 @@ class CustomPlugin(ActionPlugin):
         if _is_standard_library(module_name):
             # a library must not reach code that runs commands ('subprocess:Popen', 'os:system',
             # 'antigravity:…' opens a browser on import): plugins are the robot's own packages
-            raise ActionSetupError(f"action '{action.name}': plugin module '{module_name}' is part of Python's "
-                                   f"standard library; a custom plugin must be a class in the robot's own package")
+            raise self._error(f"plugin module '{module_name}' is part of Python's standard library; a custom "
+                              f"plugin must be a class in the robot's own package")
         try:
             module = importlib.import_module(module_name)
         except Exception as exc:  # ImportError, or the module's own import-time error
-            raise ActionSetupError(f"action '{action.name}': cannot import plugin module '{module_name}': "
-                                   f"{exc.__class__.__name__}: {exc}") from None
+            raise self._error(f"cannot import plugin module '{module_name}': "
+                              f"{exc.__class__.__name__}: {exc}") from None
         cls = getattr(module, class_name, None)
         if cls is None:
-            raise ActionSetupError(f"action '{action.name}': module '{module_name}' has no class '{class_name}'")
+            raise self._error(f"module '{module_name}' has no class '{class_name}'")
         missing = [m for m in ("start", "hold", "release") if not callable(getattr(cls, m, None))]
         if not inspect.isclass(cls) or missing:  # checked before anything of it is called
-            raise ActionSetupError(f"action '{action.name}': {action.plugin} is not a plugin class: it needs "
-                                   f"start(ctx), hold(ctx) and release(ctx) methods")
+            raise self._error(f"{action.plugin} is not a plugin class: it needs start(ctx), hold(ctx) and "
+                              f"release(ctx) methods")
         try:
             self.impl = cls(action.name, dict(action.params))
         except Exception as exc:
-            raise ActionSetupError(f"action '{action.name}': {action.plugin}({action.name!r}, params) failed: "
-                                   f"{exc.__class__.__name__}: {exc}") from None
+            raise self._error(f"{action.plugin}({action.name!r}, params) failed: "
+                              f"{exc.__class__.__name__}: {exc}") from None
         self.per_behaviour = bool(getattr(self.impl, "per_behaviour", False))
         self.period = getattr(self.impl, "period", None)
 
+    def _error(self, text: str) -> ActionSetupError:
+        """The error as `rubass check` prints a library's: FILE:LINE:COL of its `plugin:` entry, the line, a caret."""
+        span, line = plugin_place(self.action)
+        message = f"action '{self.name}': {text}"
+        if span.line <= 0:  # an action made in code, not read from a library
+            return ActionSetupError(message)
+        return ActionSetupError(Diagnostic(span, message, line_text=line).render())
+
     def setup(self) -> None:
         if callable(getattr(self.impl, "setup", None)):
-            self.impl.setup()
+            try:
+                self.impl.setup()
+            except ActionSetupError as exc:
+                raise self._error(str(exc)) from None
+            except Exception as exc:  # the robot's own code: a clean error at its entry, not a traceback
+                raise self._error(f"{self.action.plugin}.setup() failed: {exc.__class__.__name__}: {exc}") from None
 
     def start(self, ctx: Context) -> None:
         self.impl.start(ctx)
@@ -159,6 +175,30 @@ def make_plugin(action: ActionDef) -> ActionPlugin:
         return CustomPlugin(action)
     module, _, cls = BUILTIN[action.plugin].partition(":")
     return getattr(importlib.import_module(module), cls)(action)  # type: ignore[no-any-return]
+
+
+def plugin_place(action: ActionDef) -> Tuple[Span, str]:
+    """Where the action's `plugin:` value is in its library, and that line; the action's own place
+    (its name) when the library cannot be read again or the value is not found under it."""
+    span = action.span
+    try:
+        with open(span.file, encoding="utf-8", errors="replace") as f:
+            lines = f.read().splitlines()
+    except (OSError, ValueError):
+        return span, ""
+    if not 1 <= span.line <= len(lines):
+        return span, ""
+    value = re.compile(r"\bplugin\s*:\s*(?P<v>[\"']?" + re.escape(action.plugin) + ")")
+    indent = span.col - 1
+    for i in range(span.line - 1, len(lines)):
+        text = lines[i]
+        if i > span.line - 1 and text.strip() and not text.lstrip().startswith("#") \
+                and len(text) - len(text.lstrip()) <= indent:
+            break  # the next action: this one's mapping is over
+        m = value.search(text, indent if i == span.line - 1 else 0)
+        if m:
+            return Span(span.file, i + 1, m.start("v") + 1), text
+    return span, lines[span.line - 1]
 
 
 def _is_standard_library(module_name: str) -> bool:

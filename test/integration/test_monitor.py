@@ -160,6 +160,23 @@ def test_custom_plugin_named_in_yaml_is_called(ros, tmp_path):
     assert out.read_text() == "start 1 ['a.r'] ['loud', 3.0]\nrelease\n"
 
 
+def test_a_custom_plugin_that_cannot_be_imported_is_reported_at_its_library_place(ros, tmp_path):
+    """As `rubass check` prints a library error: FILE:LINE:COL of the `plugin:` entry (it had none)."""
+    lib = tmp_path / "lib.yaml"
+    lib.write_text("actions:\n  horn: {plugin: log}\n  board: {plugin: no_such_mod.x:Y}\n")
+    path = tmp_path / "s.rbs"
+    path.write_text('import "lib.yaml";\naction primitive board;\n'
+                    'entity a { rules: r: topic /x.data > 1; }\nif (a.r) then { board; }\n')
+    mon = ros.monitor(str(path))  # up, enforcing nothing
+    place = f"{lib}:3:19: error: action 'board': cannot import plugin module 'no_such_mod.x'"
+    wait_log(mon, ros, place)
+    rec = ros.probe({"listen": [{"topic": "/diagnostics", "type": "diagnostic_msgs/DiagnosticArray"}],
+                     "steps": [{"wait": "/diagnostics", "timeout": 5}]})
+    diag = next(r for r in rec if r["topic"] == "/diagnostics")["msg"]["status"][0]
+    assert diag["level"] == 2 and "NOT ENFORCING ANY RULE: " + place in diag["message"], diag
+    assert "Traceback" not in ros.log(mon)
+
+
 @pytest.mark.parametrize("params,message", [
     ({}, "~spec is required"),
     ({"spec": "SPEC", "rate": "fast"}, "~rate must be a rate from 1 to 1000 Hz"),
