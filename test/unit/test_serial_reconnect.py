@@ -62,7 +62,11 @@ def plugin(board):
 def away_and_back(board, p):
     board.unplug()
     for _ in range(3):  # the plugin notices the device is gone; it cannot reopen it yet
-        p.periodic()
+        if p.active:  # a failure (/diagnostics ERROR) while the board that holds the stop is away
+            with pytest.raises(IOError, match="is away .* while the action is active"):
+                p.periodic()
+        else:
+            p.periodic()
     assert p.port is None
     board.plug()
     p.periodic()

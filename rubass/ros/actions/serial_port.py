@@ -86,6 +86,9 @@ class SerialPlugin(ActionPlugin):
             reopened = self.port is None and self._open()
             if not reopened and self.port is not None and not self._alive():
                 self._drop("the device went away")
+        if self.port is None and self.active:  # an ERROR in /diagnostics (logged, counted) until it is back
+            raise IOError(f"serial board {self.params['port']} is away ({self.state}) while the action is "
+                          f"active: its start is written again when it returns")
         data = _bytes(self.params.get("on_start"))
         if reopened and self.active and data and not self.started:
             try:
