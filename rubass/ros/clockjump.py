@@ -7,11 +7,13 @@ built again from the same spec at the new time (`for`, `age` and `frequency` cou
 jump, as at start-up), and what was active is held across: a latched behaviour as after a
 reload (until ~reset), any other for as long as its condition needs to become true again (its
 longest `for`, `age` limit or `frequency` window, plus 0.5 s). If the rebuilt engine starts it
-again meanwhile, it owns it (same identity: no second start); otherwise it is released then.
-Runs on the engine's thread (the loop's clock-jump hook and the tick).
+again meanwhile, it owns it (same identity): that start is no new start, its actions and ~events
+see none (`take_over`); otherwise it is released then, and ~events reports that release, so
+starts and releases stay paired. Runs on the engine's thread (the loop's clock-jump hook and the tick).
 """
 from __future__ import annotations
 
+import dataclasses
 from typing import Any, Callable, List, Tuple
 
 from ..engine import Engine, Event
@@ -47,6 +49,7 @@ class ClockJump:
         self.log = log
         self.after = after  # called with the new engine (the latch state follows)
         self.carried: List[Tuple[Any, Any, float]] = []  # (behaviour, identity, release at)
+        self.latched: List[Tuple[Any, Any]] = []  # (behaviour, identity): latched, held until ~reset
         self.jumps = 0
 
     def __call__(self, old: Engine, now: float) -> Tuple[Engine, List[Event]]:
@@ -65,7 +68,8 @@ class ClockJump:
             actions = [a.name for a in b.actions]
             if b.latched:
                 self.dispatcher.orphans.append((b, keys[index]))
-                events += new.hold_actions(actions, f"{b.label} (latched before a clock jump)", now)
+                self.latched.append((b, keys[index]))
+                events += new.hold_actions(actions, _latched(b), now)
             else:
                 self.carried.append((b, keys[index], until))
                 events += new.hold_actions(actions, _carried(b), now)  # active() stays true meanwhile
@@ -76,6 +80,39 @@ class ClockJump:
         events += new.evaluate_all(now)
         self.after(new)
         return new, events
+
+    def take_over(self, engine: Engine, events: List[Event]) -> List[Event]:
+        """Before dispatch: the start of a behaviour held across a jump (same identity) is no new
+        start: it becomes a hold, and the engine owns it from now (the hold across the jump ends)."""
+        if not (self.carried or self.latched) or not any(e.kind == "start" for e in events):
+            return events
+        keys = self.dispatcher.keys_of(engine.spec)
+        out: List[Event] = []
+        for e in events:
+            key = keys.get(e.behaviour) if e.kind == "start" else None
+            carried = [c for c in self.carried if c[1] == key] if key is not None else []
+            latched = [c for c in self.latched if c[1] == key] if key is not None else []
+            if not (carried or latched):
+                out.append(e)
+                continue
+            out.append(dataclasses.replace(e, kind="hold", witness=None))
+            more: List[Event] = []
+            for c in carried:
+                self.carried.remove(c)
+                more += engine.release_holder(_carried(c[0]), e.time)
+            for b, _ in latched:
+                self.latched.remove((b, key))
+                if (b, key) in self.dispatcher.orphans:
+                    self.dispatcher.orphans.remove((b, key))
+                more += engine.release_holder(_latched(b), e.time)
+            out += self.take_over(engine, more)
+            if latched:
+                self.after(engine)  # the latch state: the engine's own latch now, no orphan
+        return out
+
+    def reset(self) -> None:
+        """~reset released every orphan (and the engine its holders): nothing latched is carried."""
+        self.latched = [c for c in self.latched if c in self.dispatcher.orphans]
 
     def check(self, engine: Engine, now: float) -> None:
         """At each tick: release carried behaviours the rebuilt engine did not take over in time."""
@@ -89,6 +126,7 @@ class ClockJump:
                 continue  # the engine holds it again, under the same identity
             if now >= until or now < until - 3600.0:
                 self.dispatcher.release(b, key, now)
+                self.dispatcher.report_event(Event(now, "release", b.index), b, (), "deadline")  # pairs its start
                 self.dispatcher.handle(engine, engine.release_holder(_carried(b), now), "clock jump")
             else:
                 keep.append((b, key, until))
@@ -97,3 +135,7 @@ class ClockJump:
 
 def _carried(b: Any) -> str:
     return f"{b.label} (carried across a clock jump)"
+
+
+def _latched(b: Any) -> str:
+    return f"{b.label} (latched before a clock jump)"

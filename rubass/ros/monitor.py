@@ -46,7 +46,7 @@ import rospy
 from std_msgs.msg import String
 from std_srvs.srv import Trigger, TriggerResponse
 
-from ..engine import Engine
+from ..engine import Engine, Event
 from ..engine.loop import EngineLoop, Message, NodeSample
 from ..lang import SpecError, load_spec
 from ..lang.library import priority_conflicts
@@ -213,6 +213,7 @@ class Monitor(Reloading):
     def _on_events(self, events: List[Any], cause: Any) -> None:
         """On the engine's thread: the latch state is written before a latched action is dispatched."""
         engine = self.loop.engine  # type: ignore[union-attr]
+        events = self.clock_jump.take_over(engine, events)  # held across a clock jump: no second start
         if self.keeper.changes(engine, events):
             self.keeper.save(engine, self.dispatcher.orphans, self._fail_safes())
         self.dispatcher.handle(engine, events, cause)
@@ -350,7 +351,10 @@ class Monitor(Reloading):
             events = engine.reset(now)
             self._on_events(events, "reset")  # a latched start it causes is written before it is dispatched
             n = len(self.dispatcher.orphans)
+            for b, _ in self.dispatcher.orphans:  # ~events pairs their starts (clock jump, reload)
+                self.dispatcher.report_event(Event(now, "release", b.index), b, (), "reset")
             self.dispatcher.release_orphans(now)
+            self.clock_jump.reset()
             n += self.overload.reset(now, self.dispatcher.runners)
             n += self.keeper.reset(self.dispatcher.runners, now)
             n += self.error_guard.reset(now, self.dispatcher.runners)

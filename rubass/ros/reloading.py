@@ -12,7 +12,7 @@ from typing import Any, Dict, List, Optional, Tuple
 import rospy
 
 from ..actions.runner import ActionRunner
-from ..engine import Engine
+from ..engine import Engine, Event
 from ..lang import SpecError, load_spec
 from ..lang.errors import RubassError
 from ..lang.model import CheckedSpec
@@ -170,6 +170,7 @@ class Reloading:
                 self.dispatcher.orphans.append((b, old_keys[b.index]))
             else:
                 self.dispatcher.release(b, old_keys[b.index], now)
+                self.dispatcher.report_event(Event(now, "release", b.index), b, (), "reload")  # pairs its start
         for name, runner in runners.items():  # actions are carried across any reload by name
             prev = self.dispatcher.runners.get(name)
             if prev is not None and prev is not runner:

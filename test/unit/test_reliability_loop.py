@@ -100,6 +100,9 @@ def test_clock_jump_hook_holds_what_was_active_until_the_rebuilt_engine_takes_it
         def release(self, b, key, now):
             released.append((b.index, now))
 
+        def report_event(self, e, b, rules, cause):
+            pass
+
         def handle(self, engine, events, cause):
             pass
 
