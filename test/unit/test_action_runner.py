@@ -74,7 +74,9 @@ def test_failing_start_is_retried_and_logged_once():
     r.submit("start", Context(1, 0))
     assert wait_for(lambda: ("start", 1) in p.calls)
     r.stop()
-    assert r.stats.failures == 3 and len(logs) == 1 and "board away" in logs[0][1]
+    errors = [text for level, text in logs if level == "error"]
+    assert r.stats.failures == 3 and len(errors) == 1 and "board away" in errors[0]
+    assert logs[1:] == [("info", "action 'fake' start succeeded after failing (start: OSError: board away)")]
 
 
 def test_start_superseded_by_release_is_not_retried_forever():
