@@ -96,7 +96,8 @@ class Reloading:
                         if n not in spec.actions and r.active and self.spec.actions[n].latch]
                 if gone:  # actions are carried by name: a latched one that is on cannot just vanish
                     raise StartupError(f"{spec.path}: the new spec no longer declares {', '.join(gone)}, which is "
-                                       f"latched and active; call ~reset first (or keep the action's name)")
+                                       f"latched and active, and no action library it loads defines it any more "
+                                       f"(renamed or removed); call ~reset first (or keep the action's name)")
                 runners = self._runners(spec, self.runners)
             except (SpecError, StartupError) as exc:
                 text = exc.render() if isinstance(exc, SpecError) else str(exc)
