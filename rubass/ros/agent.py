@@ -23,7 +23,6 @@ import concurrent.futures
 import os
 import re
 import socket
-import sys
 import threading
 import time
 import xmlrpc.client
@@ -149,8 +148,7 @@ def main(argv: Optional[List[str]] = None) -> int:
         rate = read_rate(get, "node_rate", 10.0, 0.1, 100.0)
         discover_period = 1.0 / read_rate(get, "discover_rate", 1.0, 0.01, 100.0)
     except ParamError as exc:
-        rospy.logfatal("rubass agent: cannot start: %s", exc)
-        print(f"rubass agent: cannot start: {exc}", file=sys.stderr)
+        rospy.logfatal("rubass agent: cannot start: %s", exc)  # rospy writes it to stderr: once
         return 1
     host = urlparse(rospy.core.get_node_uri() or "").hostname or socket.gethostname()
     agent = Agent(rospy.get_name(), host, rosgraph.get_master_uri(), 1.0 / rate, log)
