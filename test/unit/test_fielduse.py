@@ -44,7 +44,7 @@ def test_each_field_read_as_one_value_has_what_the_spec_does_with_it():
     ("std_msgs/String", None, None),
 ])
 def test_the_live_type_is_checked_against_the_need(type_, need, problem):
-    genpy = pytest.importorskip("genpy")  # noqa: F841 (message classes need ROS)
+    pytest.importorskip("genpy")  # message classes need ROS
     import roslib.message
 
     from rubass.ros.msgtypes import check_path

@@ -5,7 +5,7 @@ import textwrap
 import pytest
 
 from rubass.engine import Engine
-from rubass.lang import SpecError, check_text, format_spec, load_spec, parse_text
+from rubass.lang import SpecError, format_spec, load_spec, parse_text
 
 LIB = """\
 actions:
