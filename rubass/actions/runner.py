@@ -17,6 +17,10 @@ Log = Callable[[str, str], None]  # (level, text)
 BACKOFF = (0.05, 0.1, 0.2, 0.5, 1.0)
 MAX_PENDING = 1000  # phases waiting for a plugin that is slower than the condition flaps
 LOG_EVERY = 5.0  # seconds between two log lines about the same failing action
+# the phases whose success resolves a failure of each phase; any other failure (a plugin's bad input,
+# the runner's own) is resolved by the next start, hold or release that succeeds
+_RESOLVED_BY = {"start": ("start", "release"), "release": ("release", "start"),
+                "hold": ("hold", "start", "release"), "periodic": ("periodic",)}
 
 
 class ActionRunner:
@@ -210,9 +214,15 @@ class ActionRunner:
 
     def _resolve(self, what: str) -> None:
         """A success after a failure: the error stays on record but no longer makes /diagnostics ERROR.
-        A periodic success says nothing of a start, hold or release that failed."""
+        Only a success that answers the failure resolves it: the same phase again, or the phase that
+        made it moot (a release after a failed start); a hold that wrote nothing says nothing of a
+        device that periodic() found away, nor a periodic() of a failed start."""
         error = self.stats.last_error
-        if error and not error.startswith(RESOLVED) and (what != "periodic" or error.startswith("periodic:")):
-            self.stats.last_error = RESOLVED + error
-            if not error.startswith("input:"):  # a plugin's own bad-input count is logged by the plugin
-                self.log("info", f"action '{self.plugin.name}' {what} succeeded after failing ({error})")
+        if not error or error.startswith(RESOLVED):
+            return
+        failed = error.split(":", 1)[0]
+        if what not in _RESOLVED_BY.get(failed, ("start", "hold", "release")):
+            return
+        self.stats.last_error = RESOLVED + error
+        if not error.startswith("input:"):  # a plugin's own bad-input count is logged by the plugin
+            self.log("info", f"action '{self.plugin.name}' {what} succeeded after failing ({error})")

@@ -191,3 +191,33 @@ def test_a_failure_is_marked_resolved_by_the_next_success_and_the_monitor_is_ok_
         assert any("start succeeded after failing" in t for t in logs), logs
     finally:
         r.stop()
+
+
+def test_a_hold_that_succeeds_does_not_resolve_a_failed_periodic_nor_a_periodic_a_failed_start():
+    class AwayBoard(AlwaysFails):
+        def periodic(self):
+            self.periodics += 1
+            if self.fail:
+                raise IOError("serial board /dev/x is away")
+
+    p = AwayBoard(period=0.05)
+    p.fail = False
+    r = ActionRunner(p, lambda level, text: None)
+    r.start_thread()
+    try:
+        r.submit("start", Context(1, 3))
+        p.fail = True
+        end = time.monotonic() + 3
+        while not r.stats.failures and time.monotonic() < end:
+            time.sleep(0.01)
+        for _ in range(20):  # the engine's ticks while the board is away
+            r.submit("hold", Context(1, 3))
+            time.sleep(0.01)
+        assert r.stats.last_error == "periodic: OSError: serial board /dev/x is away"
+        p.fail = False  # back
+        end = time.monotonic() + 3
+        while r.stats.last_error.startswith("periodic") and time.monotonic() < end:
+            time.sleep(0.01)
+        assert r.stats.last_error.startswith("resolved")
+    finally:
+        r.stop()
