@@ -73,7 +73,8 @@ def build(spec: CheckedSpec, rules: Dict[str, Any], active: List[int], topics: D
                     values.append((f"{key.split('.', 1)[1]} unknown because", "; ".join(reasons)))
                 errors += [r for r in reasons if "reads" in r or "changed type" in r or "deserialise" in r]
         if errors:  # named: the rule, the field and what is wrong
-            level, msg = ERROR, f"DATA ERROR: {sorted(set(errors))[0]}" + (
+            first = min(set(errors), key=lambda e: ("changed type" in e, e))  # what a rule cannot read first
+            level, msg = ERROR, f"DATA ERROR: {first}" + (
                 f" (and {len(set(errors)) - 1} more)" if len(set(errors)) > 1 else "")
         elif true_rules:
             level, msg = WARN, "violated: " + ", ".join(k.split(".", 1)[1] for k in true_rules)

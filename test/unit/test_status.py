@@ -40,3 +40,14 @@ def test_an_action_failure_is_error_only_until_a_later_attempt_succeeds():
                                 "action stop2": status.RESOLVED + "start: OSError: no node subscribes to /x"})
     assert resolved.level == status.OK and "FAILING" not in resolved.message
     assert ("action failures", "3") in resolved.values
+
+
+def test_a_type_change_shows_the_rule_and_field_it_breaks_first():
+    """Acceptance finding: 'DATA ERROR: changed type from … (and 2 more)' hid which rule reads what."""
+    spec = check_text("entity a { rules: n: topic /x.linear.x > 1; }\n")
+    topic = {"messages": 3, "errors": ["rule 'a.n' reads /x.linear.x, but in std_msgs/String: 'linear' …",
+                                       "changed type from geometry_msgs/Twist to std_msgs/String"]}
+    entries = status.build(spec, {"a.n": None}, [], {"/x": topic}, {}, {}, {})
+    entity = next(e for e in entries if e.name == "rubass: a")
+    assert entity.message.startswith("DATA ERROR: rule 'a.n' reads /x.linear.x"), entity.message
+    assert entity.message.endswith("(and 1 more)")
