@@ -5,7 +5,7 @@ from __future__ import annotations
 from typing import Dict, List, Optional, Sequence, Tuple
 
 from . import ast
-from .errors import Diagnostic, did_you_mean
+from .errors import Diagnostic, a_noun, did_you_mean
 from .model import Attrs
 from .source import Span
 
@@ -27,7 +27,7 @@ class AttrChecker:
         out: Attrs = {}
         for a in attrs:
             if a.name not in KNOWN:
-                self.diags.append(Diagnostic(a.span, f"unknown attribute '@{a.name}' on a {what}; known: "
+                self.diags.append(Diagnostic(a.span, f"unknown attribute '@{a.name}' on {a_noun(what)}; known: "
                                                      f"@id, @hazard, @title, @ref{did_you_mean(a.name, KNOWN)}"))
                 continue
             least, most = KNOWN[a.name]

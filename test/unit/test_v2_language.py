@@ -35,7 +35,7 @@ def ok(tmp_path, spec):
 
 CASES = [
     ("unknown attribute", HEAD + '@owner("me") entity e { rules: r: topic /v.x > 1; }\nif (e.r) then { stop; }\n',
-     (3, 1, "unknown attribute '@owner' on a entity; known: @id, @hazard, @title, @ref")),
+     (3, 1, "unknown attribute '@owner' on an entity; known: @id, @hazard, @title, @ref")),
     ("duplicate id", HEAD + 'entity e { rules:\n  @id("SR-1") r: topic /v.x > 1;\n  @id("SR-1") q: topic /v.x > 2;\n}\n'
      'if (e.r) then { stop; }\nif (e.q) then { warn; }\n', (5, 3, 'duplicate id "SR-1"; first given at')),
     ("id takes one string", HEAD + '@id("A", "B") entity e { rules: r: topic /v.x > 1; }\nif (e.r) then { stop; }\n',
