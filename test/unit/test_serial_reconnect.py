@@ -141,3 +141,28 @@ def test_a_failed_start_retried_by_the_runner_reaches_the_board_once_when_it_is_
     finally:
         runner.stop()
         p.close()
+
+
+def test_a_board_with_hold_bytes_that_a_hold_reopens_gets_the_start_before_the_hold(board):
+    """Review finding: with `on_hold`, a hold (50 Hz while active) reopened the port before
+    periodic() (every 0.5 s) and wrote only the hold; the start was never written again."""
+    board.plug()
+    p = SerialPlugin(ActionDef("board_stop", "serial", {"port": board.link, "baud": 115200, "write_timeout": 0.5,
+                                                        "on_start": "S\n", "on_hold": "H\n", "on_release": "R\n"}))
+    p.setup()
+    try:
+        p.active = True
+        p.start(CTX)
+        p.hold(CTX)
+        assert board.read(0.2) == b"S\nH\n"
+        board.unplug()
+        with pytest.raises(IOError):
+            p.hold(CTX)  # the write fails: the device is gone
+        board.plug()
+        p.hold(CTX)  # reopens the port before any periodic()
+        assert board.read(0.3) == b"S\nH\n"
+        p.periodic()
+        p.hold(CTX)
+        assert board.read(0.2) == b"H\n", "the start once per connection"
+    finally:
+        p.close()

@@ -74,6 +74,7 @@ class SerialPlugin(ActionPlugin):
         self.started = self.port is not None
 
     def hold(self, ctx: Context) -> None:
+        self._catch_up()  # a hold may reopen the port before periodic() does: the start first
         self._write(_bytes(self.params.get("on_hold")))
 
     def release(self, ctx: Context) -> None:
@@ -89,14 +90,21 @@ class SerialPlugin(ActionPlugin):
         if self.port is None and self.active:  # an ERROR in /diagnostics (logged, counted) until it is back
             raise IOError(f"serial board {self.params['port']} is away ({self.state}) while the action is "
                           f"active: its start is written again when it returns")
-        data = _bytes(self.params.get("on_start"))
-        if reopened and self.active and data and not self.started:
+        if self.port is not None:
             try:
-                self._write(data)
+                self._catch_up()
             except IOError:
                 return  # dropped again: the next period reopens and tries again
-            self.started = True
-            rospy.logwarn(f"action '{self.name}': serial board {self.params['port']} is back: start written again")
+
+    def _catch_up(self) -> None:
+        """While active, a connection that has not had the start gets it (a board that came back,
+        whichever of periodic() and hold() reopened it)."""
+        data = _bytes(self.params.get("on_start"))
+        if not (self.active and data and not self.started):
+            return
+        self._write(data)
+        self.started = self.port is not None
+        rospy.logwarn(f"action '{self.name}': serial board {self.params['port']} is back: start written again")
 
     def _alive(self) -> bool:
         """A pty or USB device that vanished shows as EIO/EOF on a non-blocking read."""
