@@ -17,10 +17,10 @@ Log = Callable[[str, str], None]  # (level, text)
 BACKOFF = (0.05, 0.1, 0.2, 0.5, 1.0)
 MAX_PENDING = 1000  # phases waiting for a plugin that is slower than the condition flaps
 LOG_EVERY = 5.0  # seconds between two log lines about the same failing action
-# the phases whose success resolves a failure of each phase; any other failure (a plugin's bad input,
-# the runner's own) is resolved by the next start, hold or release that succeeds
+# the phases whose success resolves a failure of each phase; a plugin's bad input only by the plugin
+# (a good input: holds succeed at 50 Hz whatever the input); the runner's own by the next phase
 _RESOLVED_BY = {"start": ("start", "release"), "release": ("release", "start"),
-                "hold": ("hold", "start", "release"), "periodic": ("periodic",)}
+                "hold": ("hold", "start", "release"), "periodic": ("periodic",), "input": ()}
 
 
 class ActionRunner:

@@ -21,6 +21,7 @@ import rospy
 from ...actions.clamp import AXES, clamp_twist
 from .arbiter import take_seat
 from ...actions.base import ActionPlugin, Context
+from ...actions.status import RESOLVED
 from .publish import ros_class
 
 LOG_EVERY = 5.0
@@ -66,6 +67,7 @@ class LimitPlugin(ActionPlugin):
                        f"its commands are ignored (so after {self.timeout:g} s it publishes zero)")
             return
         _LATEST[self.input] = (raw._buff, now)
+        self._input_ok()
         with self._lock:
             if not self._on:  # decoded only if a start needs it
                 self._raw, self._raw_at = raw._buff, now
@@ -154,6 +156,12 @@ class LimitPlugin(ActionPlugin):
                 return -1
             self.pub.publish(msg)
             return self.pub.get_num_connections()
+
+    def _input_ok(self) -> None:
+        """A well-typed command came: a bad-input error no longer makes /diagnostics ERROR."""
+        error = self.stats.last_error
+        if error.startswith("input:"):
+            self.stats.last_error = RESOLVED + error
 
     def _fail(self, text: str) -> None:
         """A bad input is no command (the timeout turns it into zero): counted in /diagnostics,
