@@ -39,6 +39,19 @@ def default_path(ros_home: Optional[str], node_name: str) -> str:
     return os.path.join(home, "rubass", (node_name.strip("/").replace("/", "_") or "rubass") + ".latches.json")
 
 
+def adopt_old_default(path: str, old: str) -> bool:
+    """Move a latch state file kept under the monitor's former default name (`rubass_monitor`,
+    before a plain rosrun was named `rubass`) to `path`, when `path` has none: a stop latched
+    before an upgrade survives it. True when it moved."""
+    if os.path.exists(path) or not os.path.isfile(old):
+        return False
+    try:
+        os.replace(old, path)
+    except OSError:
+        return False
+    return True
+
+
 def load(path: str, declared: Dict[str, bool]) -> Tuple[List[Latch], List[str]]:
     """The latches a previous run left (none if there is no file) and the problems found.
 

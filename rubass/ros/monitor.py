@@ -65,7 +65,7 @@ from ..actions.overload import OverloadGuard
 from .clockjump import ClockJump
 from ..actions.errorguard import ErrorGuard
 from ..actions.keeper import LatchKeeper
-from ..actions.latches import LatchFile, default_path
+from ..actions.latches import LatchFile, adopt_old_default, default_path
 from .params import MonitorConfig, ParamError, read_config, spec_warnings, unknown_params
 from .gcfreeze import freeze_heap
 from .timerslack import exact_timers
@@ -461,9 +461,13 @@ def main(argv: Optional[List[str]] = None) -> int:
         names = []
     for warning in unknown_params(names, rospy.get_name()):  # a typo must not pass silently
         rospy.logwarn("rubass: %s", warning)
+    state_file = default_path(os.environ.get("ROS_HOME"), rospy.get_name())
+    if rospy.get_name() == "/rubass":  # a plain rosrun was /rubass_monitor before version 2's last stop
+        old = default_path(os.environ.get("ROS_HOME"), "/rubass_monitor")
+        if adopt_old_default(state_file, old):
+            rospy.logwarn("rubass: latch state %s moved to %s (the node's new default name)", old, state_file)
     try:
-        config = read_config(lambda name, default: rospy.get_param("~" + name, default),
-                             default_path(os.environ.get("ROS_HOME"), rospy.get_name()))
+        config = read_config(lambda name, default: rospy.get_param("~" + name, default), state_file)
         monitor = Monitor(config)
         monitor.setup()
     except (ParamError, ConfigError) as exc:

@@ -54,3 +54,19 @@ def test_a_foreign_file_and_undeclared_actions_are_reported(tmp_path):
                                 "latched": [{"holder": "b", "actions": ["stop", "halt"]}]}))
     latches, problems = load(str(path), DECLARED)
     assert latches == [Latch("b", ("stop",))] and "halt" in problems[0] and "cannot hold" in problems[0]
+
+
+def test_a_latch_file_under_the_former_default_name_is_adopted_once(tmp_path):
+    """A plain rosrun monitor was /rubass_monitor; it is /rubass now: its latched stop must survive."""
+    from rubass.actions.latches import adopt_old_default, default_path
+
+    home = str(tmp_path)
+    new, old = default_path(home, "/rubass"), default_path(home, "/rubass_monitor")
+    os.makedirs(os.path.dirname(old))
+    with open(old, "w") as fh:
+        fh.write("{}")
+    assert adopt_old_default(new, old) and os.path.isfile(new) and not os.path.exists(old)
+    with open(old, "w") as fh:
+        fh.write("{}")
+    assert not adopt_old_default(new, old), "a file under the new name is never replaced"
+    assert adopt_old_default(str(tmp_path / "x.json"), str(tmp_path / "none.json")) is False

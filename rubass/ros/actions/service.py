@@ -9,6 +9,7 @@ import roslib.message
 import rospy
 
 from ...actions.base import ActionPlugin, Context
+from ..rpc import proxy
 from .publish import build_message, ros_class
 
 
@@ -25,11 +26,7 @@ class ServicePlugin(ActionPlugin):
         result: List[Any] = []
 
         def call() -> None:
-            try:
-                if not self._advertised():  # no use waiting: say so at once (the runner retries)
-                    result.append(LookupError(f"service {self.params['service']} does not exist (not advertised "
-                                              f"on the master)"))
-                    return
+            try:  # a service that appears within the timeout (its node restarting) is called at once
                 self.proxy.wait_for_service(timeout)
                 result.append(self.proxy.call(self.request))
             except Exception as exc:  # rospy.ServiceException, ROSException, ROSInterruptException
@@ -38,22 +35,21 @@ class ServicePlugin(ActionPlugin):
         worker = threading.Thread(target=call, name=f"rubass-service-{self.name}", daemon=True)
         worker.start()
         worker.join(timeout)
-        if not result:
+        if not result or type(result[0]) is rospy.ROSException:  # timed out: waiting for it, or in the call
+            if not self._advertised():  # asked only now, to say why
+                raise IOError(f"service {self.params['service']} does not exist (not advertised on the master)")
             raise TimeoutError(f"service {self.params['service']} did not answer within {timeout:g} s")
-        if isinstance(result[0], LookupError):
-            raise IOError(str(result[0]))
         if isinstance(result[0], Exception):
             raise IOError(f"service {self.params['service']}: {result[0]}")
 
     def _advertised(self) -> bool:
-        """Whether the master knows the service; True when the master cannot say (then the call tries)."""
+        """Whether the master knows the service; True when the master cannot say within 0.5 s."""
         try:
-            rosgraph.Master(rospy.get_name()).lookupService(self.proxy.resolved_name)
+            code, _, _ = proxy(rosgraph.get_master_uri(), 0.5).lookupService(rospy.get_name(),
+                                                                             self.proxy.resolved_name)
+        except Exception:  # master unreachable or hung: the timeout is the answer
             return True
-        except rosgraph.MasterError:  # the master answered: no such service
-            return False
-        except Exception:  # master unreachable or hung: the call's own timeout tells
-            return True
+        return code == 1
 
     def start(self, ctx: Context) -> None:
         if "start" in self.params["call_on"]:
