@@ -39,7 +39,9 @@ def unknown_params(names: List[str], node: str) -> List[str]:
     """A warning for each private parameter of `node` (full names from the master) that the monitor
     does not read (a typo such as `_rat:=5` would otherwise be silently ignored)."""
     prefix = node.rstrip("/") + "/"
-    found = sorted({n[len(prefix):].split("/")[0] for n in names if n.startswith(prefix)} - set(KNOWN) - {""})
+    # a leaf right under the node; a group deeper down is another node's (an agent in ns="rubass")
+    found = sorted({n[len(prefix):] for n in names if n.startswith(prefix) and "/" not in n[len(prefix):]}
+                   - set(KNOWN) - {""})
     return [f"unknown parameter ~{n} (ignored){did_you_mean('~' + n, ['~' + k for k in KNOWN])}" for n in found]
 
 
