@@ -45,3 +45,13 @@ def ros(tmp_path):
     r = Ros(tmp_path)
     yield r
     r.stop()
+
+
+class Clock:
+    """A clock the test sets by hand (clock.t), for EngineLoop and the monitor's parts."""
+
+    def __init__(self, t=100.0):
+        self.t = t
+
+    def __call__(self):
+        return self.t

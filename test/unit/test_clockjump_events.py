@@ -9,17 +9,9 @@ from rubass.engine.loop import EngineLoop, Message
 from rubass.lang import check_text
 from rubass.ros.clockjump import ClockJump
 
-from conftest import ROOT
+from conftest import ROOT, Clock
 
 LIB = os.path.join(ROOT, "docs", "examples", "actions.yaml")
-
-
-class Clock:
-    def __init__(self):
-        self.t = 100.0
-
-    def __call__(self):
-        return self.t
 
 
 def monitor(body):

@@ -6,17 +6,9 @@ from rubass.engine import Engine
 from rubass.engine.loop import EngineLoop, Message
 from rubass.lang import check_text
 
-from conftest import ROOT
+from conftest import ROOT, Clock
 
 LIB = os.path.join(ROOT, "docs", "examples", "actions.yaml")
-
-
-class Clock:
-    def __init__(self):
-        self.t = 100.0
-
-    def __call__(self):
-        return self.t
 
 
 def make(body, max_queue=10):
