@@ -23,9 +23,10 @@ rospy.Subscriber("/rubass/events", String, event)
 clock = rospy.Publisher("/clock", Clock, queue_size=10)
 odom = rospy.Publisher("/odom", Float64, queue_size=10)
 end = time.time() + 10
-while odom.get_num_connections() < 1 and time.time() < end:
+while odom.get_num_connections() < 1 and time.time() < end:  # the monitor watches from the first /clock
+    clock.publish(Clock(clock=rospy.Time.from_sec(111.0)))
     time.sleep(0.05)
-time.sleep(1.0)
+time.sleep(0.5)
 
 def run(t0, seconds, flowing):
     """Sim time from t0 at the wall's pace: /clock at 100 Hz, /odom at 10 Hz while flowing."""
@@ -39,7 +40,7 @@ def run(t0, seconds, flowing):
         time.sleep(0.01)
     return t0 + seconds
 
-t = run(112.0, 2.0, False)   # no /odom: silent from 112.5 s
+t = run(112.0, 1.2, False)   # no /odom: silent from 112.5 s
 t = run(5.0, 2.5, False)     # a simulator reset to 5 s; still silent (true again at 5.5 s)
 t = run(t, 1.5, True)        # /odom flows: the cause is gone
 time.sleep(0.5)
