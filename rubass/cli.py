@@ -83,7 +83,9 @@ def cmd_fmt(args: argparse.Namespace) -> int:
 
 
 def _parser() -> argparse.ArgumentParser:
-    p = argparse.ArgumentParser(prog="rubass", description="RuBaSS safety specs: check, format, replay; the paper's experiments.")
+    p = argparse.ArgumentParser(prog="rubass", description="RuBaSS safety specs: check (also against a robot's "
+                                "model), format, rule tests, replay of recordings, the certification report; the "
+                                "paper's experiments.")
     sub = p.add_subparsers(dest="command", metavar="COMMAND")
     c = sub.add_parser("check", help="check specs for errors")
     c.add_argument("spec", nargs="+", metavar="SPEC")
@@ -108,7 +110,12 @@ def _parser() -> argparse.ArgumentParser:
 
 def main(argv: Optional[List[str]] = None) -> int:
     parser = _parser()
-    args = parser.parse_args(argv)
+    args, extra = parser.parse_known_args(argv)
+    if extra:  # named by the command's own usage, not the top level's
+        command = getattr(args, "command", None)
+        sub = next((a for a in parser._actions if isinstance(a, argparse._SubParsersAction)), None)
+        target = sub.choices.get(command, parser) if sub is not None and command else parser
+        target.error(f"unrecognized arguments: {' '.join(extra)}")
     if not getattr(args, "func", None):
         parser.print_usage(sys.stderr)
         print("rubass: error: a command is required (check, fmt, ...)", file=sys.stderr)

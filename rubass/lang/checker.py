@@ -263,6 +263,15 @@ class _Checker:
                                            f"({where}){did_you_mean(ident.name, library)}")
         return declared
 
+    def _own_span(self, d: ast.Behaviour) -> Span:
+        """A behaviour's span from its name or its `if`, after its attributes: its line is the one
+        events, tests and reports give (docs/replay.md: 'the line of its if')."""
+        src = self.sources.get(d.span.file)
+        if not d.attrs or src is None:
+            return d.span
+        start = d.name.span.start if d.name is not None else src.text.rfind("if", d.span.start, d.cond.span.start)
+        return src.span(start, d.span.end) if d.span.start <= start < d.span.end else d.span
+
     def _broken_in_library(self, name: str) -> bool:
         """True when a library defines `name` but its definition had errors (already reported)."""
         return any(d.subject == name for d in self.diags)
@@ -298,7 +307,7 @@ class _Checker:
                 self.warnings.append(Diagnostic(d.span, "this behaviour has no actions", "warning"))
             sig = f"if ({format_expr(cond)}) then {{{' '.join(a.name + repr(a.args) for a in bound)}}}"
             name = d.name.name if d.name is not None else ""
-            out.append(CheckedBehaviour(index, cond, tuple(bound), d.span, sig, name,
+            out.append(CheckedBehaviour(index, cond, tuple(bound), self._own_span(d), sig, name,
                                         self.attrs.own(d.attrs, "behaviour")))
         for name, span in declared.items():
             if name not in used:

@@ -4,6 +4,7 @@ from __future__ import annotations
 import argparse
 import gc
 import json
+import os
 import sys
 from contextlib import contextmanager
 from typing import Any, Iterable, Iterator, Set, Tuple
@@ -20,7 +21,8 @@ def register(sub: "argparse._SubParsersAction[argparse.ArgumentParser]") -> None
     p.add_argument("spec", metavar="SPEC")
     p.add_argument("bag", metavar="BAG")
     p.add_argument("--json", action="store_true", help="print one JSON object per line (docs/replay.md)")
-    p.add_argument("--plot", metavar="FILE.png", help="write a timeline picture")
+    p.add_argument("--plot", metavar="FILE.png", type=plot_path,
+                   help="write a timeline picture (.png, .pdf, .svg, .jpg; .png if the name has none)")
     p.add_argument("--actions", action="append", default=[], metavar="LIB.yaml",
                    help="an action library to load besides the spec's imports (repeatable)")
     p.add_argument("--rate", type=_rate, default=50.0, metavar="HZ", help="tick rate (default 50)")
@@ -82,7 +84,8 @@ def run(args: argparse.Namespace) -> int:
         topic_map = spellings(spec.topics)  # bag name -> every spelling of it in the spec (docs/replay.md)
         for name in sorted(topic_map):
             if name not in info.types:
-                print(f"rubass replay: warning: topic {name} is not in {args.bag}; its values stay unknown",
+                print(f"rubass replay: warning: topic {name} is not in {args.bag}; its fields stay unknown and "
+                      f"its age() grows from the recording's start",
                       file=sys.stderr)
         node_topics = sorted(t for t, ty in info.types.items() if t.endswith("/node_samples") and ty == "std_msgs/String")
         agent_topics = sorted(t for t, ty in info.types.items()
@@ -97,6 +100,17 @@ def run(args: argparse.Namespace) -> int:
         except BagError as exc:
             print(f"rubass replay: error: {exc}", file=sys.stderr)
             return 1
+        try:  # the recording's types as a system model: an array used as a number, len() of a
+            # string… are errors at the spec's line, as `rubass check --bag` reports them (issue 20.6)
+            from ..ros.model_sources import bag_model
+
+            load_spec(args.spec, args.actions, model=bag_model(args.bag))
+        except SpecError as exc:
+            print(exc.render(), file=sys.stderr)
+            return 1
+        except BagError as exc:
+            print(f"rubass replay: error: {exc}", file=sys.stderr)
+            return 1
         errors = []
         readers = [((t, p), owners) for t, paths in spec.field_readers(implicit=False).items() for p, owners in paths.items()]
         for (topic, path), owners in sorted(readers, key=str):
@@ -108,17 +122,6 @@ def run(args: argparse.Namespace) -> int:
                               f"{info.types[resolve(topic)]}: {problem}")
         if errors:
             print("\n".join(errors), file=sys.stderr)
-            return 1
-        try:  # the recording's types as a system model: an array used as a number, len() of a
-            # string… are errors at the spec's line, as `rubass check --bag` reports them (issue 20.6)
-            from ..ros.model_sources import bag_model
-
-            load_spec(args.spec, args.actions, model=bag_model(args.bag))
-        except SpecError as exc:
-            print(exc.render(), file=sys.stderr)
-            return 1
-        except BagError as exc:
-            print(f"rubass replay: error: {exc}", file=sys.stderr)
             return 1
         from .run import replay
 
@@ -148,16 +151,35 @@ def run(args: argparse.Namespace) -> int:
     if args.json:
         report.json_lines(events, sys.stdout)
     else:
-        print(f"replay of {args.spec} over {args.bag}: {duration:.3f} s, {info.messages} messages")
+        print(f"replay of {args.spec} over {args.bag}: {duration:.3f} s, {info.messages} "
+              f"message{'s' if info.messages != 1 else ''}")
         report.human(spec, events, duration, sys.stdout)
     if args.plot:
         from .plot import plot
 
         try:
             plot(spec, events, duration, args.plot, title=f"{args.spec} over {args.bag}")
-        except OSError as exc:
-            print(f"rubass replay: error: cannot write {args.plot}: {exc.strerror or exc}", file=sys.stderr)
+        except (OSError, ValueError) as exc:  # a full disk, a format the plotting back end lacks
+            print(f"rubass replay: error: cannot write {args.plot}: {getattr(exc, 'strerror', None) or exc}",
+                  file=sys.stderr)
             return 1
         if not args.json:
             print(f"timeline written to {args.plot}")
     return 0
+
+
+def plot_path(path: str) -> str:
+    """The timeline's file: .png when it names no format; an argparse error for a folder or a
+    format matplotlib cannot write (checked before the replay, not after it)."""
+    if os.path.isdir(path):
+        raise argparse.ArgumentTypeError(f"{path} is a folder: name the image file, e.g. {path.rstrip('/')}/timeline.png")
+    ext = os.path.splitext(path)[1].lower().lstrip(".")
+    if not ext:
+        return path + ".png"
+    if ext not in PLOT_FORMATS:
+        raise argparse.ArgumentTypeError(f"cannot write a timeline as '.{ext}': use one of "
+                                         f"{', '.join('.' + f for f in PLOT_FORMATS)}")
+    return path
+
+
+PLOT_FORMATS = ("png", "pdf", "svg", "jpg", "jpeg")

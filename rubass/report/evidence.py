@@ -199,7 +199,8 @@ def replay_bag(spec: CheckedSpec, path: str, rate: float = 50.0) -> BagRun:
     with bag:
         names = spellings(spec.topics)  # bag name -> every spelling of it in the spec, as replay feeds them
         present = [t for t in names if t in info.types]
-        run.warnings = [f"topic {t} is not in the recording; its values stay unknown" for t in sorted(names)
+        run.warnings = [f"topic {t} is not in the recording; its fields stay unknown and its age() grows from "
+                        f"the recording's start" for t in sorted(names)
                         if t not in info.types]
         strings = [t for t, ty in info.types.items() if ty == "std_msgs/String"] if spec.nodes else []
         node_topics = sorted(t for t in strings if t.endswith("/node_samples"))

@@ -11,7 +11,7 @@ from dataclasses import dataclass
 from typing import Any, Dict, Iterator, List, Optional, Set, Tuple, Union
 
 from ..lang.errors import RubassError
-from .bagfile import BagFile, BagFormatError, Unindexed, Unsupported
+from .bagfile import BagFile, BagFormatError, NoMessageSupport, Unindexed, Unsupported
 
 
 class BagError(RubassError):
@@ -84,6 +84,8 @@ def message_classes(bag: Bag, topics: List[str]) -> Dict[str, Any]:
                 cls = bag.topic_class(topic)
             except BagFormatError as exc:
                 raise BagError(f"{bag.filename}: the bag is corrupt: {exc}") from None
+            except NoMessageSupport as exc:
+                raise BagError(f"{bag.filename}: topic {topic}: {exc}") from None
             if cls is not None:
                 out[topic] = cls
             continue
@@ -102,6 +104,8 @@ def read(bag: Bag, topics: List[str], decode: Set[str]) -> Iterator[Tuple[float,
             yield from bag.read(topics, decode)
         except BagFormatError as exc:
             raise BagError(f"{bag.filename}: the bag is corrupt: {exc}") from None
+        except NoMessageSupport as exc:
+            raise BagError(f"{bag.filename}: {exc}") from None
         except OSError as exc:
             raise BagError(f"{bag.filename}: the bag cannot be read ({exc.__class__.__name__}: {exc})") from None
         except MemoryError:

@@ -12,14 +12,17 @@ from __future__ import annotations
 
 import os
 import struct
+import sys
 from typing import Any, Dict, Iterable, Iterator, List, Optional, Set, Tuple
 
 from .bagrecords import (FIELD_CONN, FIELD_OP, FIELD_TIME, MSG_FIELDS, MSG_HEADER_LEN, MSG_PREFIX, NS, OP_CHUNK,
                          OP_CHUNK_INFO, OP_CONNECTION, OP_FILE_HEADER, OP_MSG_DATA, U32, VERSION_LINE,
-                         BagFormatError, Chunk, Connection, Unindexed, Unsupported, decompressor, fields_of,
+                         BagFormatError, Chunk, Connection, NoMessageSupport, Unindexed, Unsupported, decompressor,
+                         fields_of,
                          int_field, message_class, message_layout, op_of, record_at, seconds, str_field, time_field)
 
-__all__ = ["BagFile", "BagFormatError", "Chunk", "Connection", "Unindexed", "Unsupported", "message_class"]
+__all__ = ["BagFile", "BagFormatError", "Chunk", "Connection", "NoMessageSupport", "Unindexed", "Unsupported",
+           "message_class"]
 
 
 class BagFile:
@@ -215,6 +218,10 @@ class BagFile:
     def _class(self, conn: Connection) -> Any:
         try:
             return message_class(conn)
+        except ImportError as exc:  # the python3 first on PATH has no ROS (ros1-notes.md)
+            raise NoMessageSupport(f"{conn.datatype} needs ROS 1's Python message support, which this "
+                                   f"interpreter ({sys.executable}) cannot import ({exc}): run rubass with "
+                                   f"/usr/bin/python3") from None
         except Exception as exc:  # genmsg errors on a broken recorded definition
             raise BagFormatError(f"topic {conn.topic}: no message class for {conn.datatype} "
                                  f"({exc.__class__.__name__}: {exc})") from None

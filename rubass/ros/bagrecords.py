@@ -55,6 +55,10 @@ class Unsupported(Exception):
     """A bag this reader does not handle (another format version, encryption, a compression)."""
 
 
+class NoMessageSupport(Exception):
+    """ROS 1's Python message support (genpy) cannot be imported: the bag is fine, the interpreter is not."""
+
+
 @dataclass(frozen=True)
 class Connection:
     """A connection record: the attributes rosbag's _ConnectionInfo has."""

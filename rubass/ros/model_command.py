@@ -33,8 +33,15 @@ def add_source_options(parser: argparse.ArgumentParser, for_check: bool) -> None
 def build_model(args: argparse.Namespace) -> Tuple[Optional[SystemModel], int]:
     """The model the options name (None when none), or an exit status when it cannot be had;
     problems are printed."""
-    model, status = _build_model(args)
     urdf = getattr(args, "urdf", None)
+    sourced = getattr(args, "bag", None) or getattr(args, "live", False) or getattr(args, "model", None)
+    if urdf and not sourced:  # options without what they apply to are errors, not silently ignored
+        print("rubass: error: --urdf needs --bag, --live or --model", file=sys.stderr)
+        return None, 2
+    if getattr(args, "master", None) and not getattr(args, "live", False):
+        print("rubass: error: --master needs --live (it names the master to ask)", file=sys.stderr)
+        return None, 2
+    model, status = _build_model(args)
     if model is None or not urdf:
         return model, status
     try:
@@ -110,7 +117,11 @@ def cmd_model(args: argparse.Namespace) -> int:
 
 def register(sub: "argparse._SubParsersAction") -> None:
     """Add `rubass model` to the command line."""
-    m = sub.add_parser("model", help="write a system model (topics, types, nodes) from a recording or the live graph")
+    m = sub.add_parser("model", help="write a system model (topics, types, nodes) from a recording or the live graph",
+                       description="Write a system model of a robot (its topics, their message types and "
+                                   "definitions, its nodes) from a recording (--bag) or the running graph (--live), "
+                                   "for `rubass check --model` with no ROS running (docs/model.md). Exit 0 written, "
+                                   "2 a source that cannot be read.")
     add_source_options(m, for_check=False)
     m.add_argument("-o", "--output", metavar="ROBOT.yaml", help="write to this file (default: standard output)")
     m.set_defaults(func=cmd_model)

@@ -90,7 +90,8 @@ def test_missing_topic_is_a_warning_and_stays_unknown(write, tmp_path):
     bag = write_bag(str(tmp_path / "b.bag"), [(0.0, "/other", Float64(1.0))])
     proc = replay(spec_file(write, SPEED), bag, "--json")
     assert proc.returncode == 0
-    assert f"warning: topic /cmd_vel is not in {bag}; its values stay unknown" in proc.stderr
+    assert (f"warning: topic /cmd_vel is not in {bag}; its fields stay unknown and its age() grows from the "
+            "recording's start") in proc.stderr
     assert [json.loads(x)["value"] for x in proc.stdout.splitlines()] == [None]
 
 
@@ -99,9 +100,9 @@ def test_field_not_in_recorded_type_names_rule_field_and_type(write, tmp_path):
     spec = spec_file(write, "entity base { rules: fast: topic /cmd_vel.linear.q > 1; }\nif (base.fast) then { stop; }\n")
     proc = replay(spec, bag)
     assert proc.returncode == 1 and proc.stdout == ""
-    assert proc.stderr.strip() == (
-        "rubass replay: error: rule 'base.fast' reads /cmd_vel.linear.q, but in geometry_msgs/Twist: "
-        "'linear' (geometry_msgs/Vector3) has no field 'q' (fields: x, y, z)")
+    # at its place, as `rubass check --bag` prints it (README: errors point at the place, all at once)
+    assert proc.stderr.splitlines()[0] == (
+        f"{spec}:3:28: error: 'linear' (geometry_msgs/Vector3) has no field 'q' (its fields: x, y, z)")
 
 
 def test_field_that_is_a_message_not_a_value(write, tmp_path):
@@ -109,7 +110,8 @@ def test_field_that_is_a_message_not_a_value(write, tmp_path):
     spec = spec_file(write, "entity base { rules: fast: topic /cmd_vel.linear > 1; }\nif (base.fast) then { stop; }\n")
     proc = replay(spec, bag)
     assert proc.returncode == 1
-    assert "'linear' is a message (geometry_msgs/Vector3), not a value" in proc.stderr
+    assert proc.stderr.startswith(f"{spec}:3:28: error: 'topic /cmd_vel.linear' is a message, not a value: "
+                                  "it is a geometry_msgs/Vector3"), proc.stderr
 
 
 @pytest.mark.parametrize("content,expected", [
@@ -208,3 +210,53 @@ def test_stamp_age_is_measured_against_the_recordings_own_time(write, tmp_path):
     # stale 0.5 s after each fresh stamp (the data ages between messages too), still stale with the
     # 1-second-old message at 2 s, fresh again at 3 s (the end of the recording)
     assert got == [("start", 0.5), ("release", 1.0), ("start", 1.5), ("release", 3.0)], got
+
+
+def test_every_field_error_of_a_spec_is_reported_at_its_place(write, tmp_path):
+    """Acceptance finding: replay stopped at the first wrong field, with no place."""
+    from sensor_msgs.msg import LaserScan
+
+    bag = write_bag(str(tmp_path / "b.bag"), [(0.0, "/cmd_vel", twist(1.0)), (0.1, "/scan", LaserScan())])
+    spec = spec_file(write, "entity base { rules:\n  fast: topic /cmd_vel.linear.q > 0.3;\n"
+                            "  arr: topic /scan.ranges > 1 m;\n}\nif (base.fast or base.arr) then { stop; }\n")
+    proc = replay(spec, bag)
+    assert proc.returncode == 1
+    assert f"{spec}:4:9: error: 'linear' (geometry_msgs/Vector3) has no field 'q'" in proc.stderr, proc.stderr
+    assert f"{spec}:5:8: error: 'topic /scan.ranges' is an array" in proc.stderr, proc.stderr
+
+
+@pytest.mark.parametrize("plot,error", [
+    ("x.txt", "argument --plot: cannot write a timeline as '.txt': use one of .png, .pdf, .svg, .jpg, .jpeg"),
+    ("", "argument --plot: {tmp} is a folder: name the image file"),
+])
+def test_a_plot_file_that_cannot_be_written_is_refused_before_the_replay(write, tmp_path, plot, error):
+    """Acceptance finding: '.txt' gave matplotlib's traceback after the whole replay."""
+    bag = write_bag(str(tmp_path / "b.bag"), [(0.0, "/cmd_vel", twist(1.0))])
+    proc = replay(spec_file(write, SPEED), bag, "--plot", str(tmp_path / plot) if plot else str(tmp_path))
+    assert proc.returncode == 2 and proc.stdout == ""
+    assert error.format(tmp=tmp_path) in proc.stderr, proc.stderr
+
+
+def test_a_plot_name_without_a_format_is_written_as_png_and_named_so(write, tmp_path):
+    bag = write_bag(str(tmp_path / "b.bag"), [(0.0, "/cmd_vel", twist(1.0))])
+    proc = replay(spec_file(write, SPEED), bag, "--plot", str(tmp_path / "timeline"))
+    assert proc.returncode == 0, proc.stderr
+    assert f"timeline written to {tmp_path / 'timeline.png'}" in proc.stdout
+    assert (tmp_path / "timeline.png").stat().st_size > 1000
+
+
+def test_a_message_class_that_needs_ros_python_is_not_called_a_corrupt_bag(write, tmp_path, monkeypatch):
+    """Acceptance finding: the python3 first on PATH (no genpy) got 'the bag is corrupt'."""
+    from rubass.ros.bag import BagError, message_classes, open_bag
+
+    bag_path = write_bag(str(tmp_path / "b.bag"), [(0.0, "/cmd_vel", twist(1.0))])
+
+    def no_genpy(conn):
+        raise ModuleNotFoundError("No module named 'genpy'")
+
+    monkeypatch.setattr("rubass.ros.bagfile.message_class", no_genpy)
+    bag, _ = open_bag(bag_path)
+    with bag, pytest.raises(BagError) as info:
+        message_classes(bag, ["/cmd_vel"])
+    text = str(info.value)
+    assert "corrupt" not in text and "needs ROS 1's Python message support" in text and "/usr/bin/python3" in text

@@ -241,3 +241,13 @@ def test_len_of_a_whole_array_of_messages_counts_them(tmp_path):
     assert [engine.store.rules[k] for k in ("e.n3", "e.none")] == [False, False]
     engine.on_message("/d", 3.0, DiagnosticArray(status=[]))
     assert [engine.store.rules[k] for k in ("e.n3", "e.none")] == [False, True]
+
+
+def test_a_behaviours_line_is_its_if_or_name_not_its_first_attribute(tmp_path):
+    """docs/replay.md: `line` is the line of its `if` (acceptance finding: it was the @id's line)."""
+    spec = ok(tmp_path, HEAD + "entity e { rules: r: topic /v.x > 1; }\n"
+                               '@id("B-1")\n@hazard("H1")\nif (e.r) then { stop; }\n'
+                               '@id("B-2")\nnamed: if (e.r) then { warn; }\n'
+                               '@id("B-3") if (\n  e.r) then { warn; }\n'
+                               "if (e.r) then { stop; }\n")
+    assert [b.span.line for b in spec.behaviours] == [6, 8, 9, 11]
