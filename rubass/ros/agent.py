@@ -35,7 +35,7 @@ from ..engine.values import UNKNOWN
 from . import rpc
 from .agentbook import AGENT_TOPIC, encode, is_loopback, node_entry
 from .nodes import NodeSampler, NodeStatus
-from .params import ParamError, read_rate
+from .params import ParamError, read_rate, unknown_params
 
 Log = Callable[[str, str], None]
 
@@ -133,6 +133,9 @@ class Agent:
         self.sampler._release()
 
 
+AGENT_PARAMS = ("node_rate", "discover_rate")  # what main() reads
+
+
 def main(argv: Optional[List[str]] = None) -> int:
     import rosgraph
     import rospy
@@ -143,6 +146,12 @@ def main(argv: Optional[List[str]] = None) -> int:
     rospy.init_node(default_name(), argv=argv)
     log: Log = lambda level, text: {"debug": rospy.logdebug, "info": rospy.loginfo,  # noqa: E731
                                     "warn": rospy.logwarn, "error": rospy.logerr}[level](text)
+    try:
+        names = rospy.get_param_names()
+    except Exception:  # noqa: BLE001 - only the warnings below are lost
+        names = []
+    for warning in unknown_params(names, rospy.get_name(), AGENT_PARAMS):  # a typo must not pass silently
+        rospy.logwarn("rubass agent: %s", warning)
     try:
         get = lambda name, default: rospy.get_param("~" + name, default)  # noqa: E731
         rate = read_rate(get, "node_rate", 10.0, 0.1, 100.0)

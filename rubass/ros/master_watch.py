@@ -117,12 +117,16 @@ class MasterWatch:
             code, msg, uri = self._caller.call("lookupNode", self.caller_id, self.caller_id)
             pid = self._caller.call("getPid", self.caller_id)[2]
         except (OSError, socket.error, xmlrpc.client.Error) as exc:
-            if self.down_since is None:
+            first = self.down_since is None
+            if first:
                 self.down_since = time.monotonic()
+            # the state first: with the master's host cut off, rospy's log call itself can block
+            # (its /rosout goes there) until the link is back, and /diagnostics must say it meanwhile
+            self.state = f"unreachable for {time.monotonic() - self.down_since:.1f} s"
+            if first:
                 self.log("warn", f"the master at {self.master_uri} cannot be reached ({exc}): existing connections "
                                  f"keep working and the rules keep being enforced; nodes started now cannot "
                                  f"connect to the monitor until the master is back")
-            self.state = f"unreachable for {time.monotonic() - self.down_since:.1f} s"
             return "unreachable"
         was_down, self.down_since = self.down_since, None
         was_pid, self.master_pid = self.master_pid, pid

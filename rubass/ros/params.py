@@ -4,7 +4,7 @@ from __future__ import annotations
 import os
 import re
 from dataclasses import dataclass, field
-from typing import Any, Callable, List, Optional
+from typing import Any, Callable, List, Optional, Sequence
 
 from ..lang.errors import Diagnostic, RubassError, did_you_mean
 from ..lang.units import FREQUENCY, parse_quantity
@@ -35,14 +35,14 @@ KNOWN = ("spec", "actions", "rate", "node_rate", "diagnostics_rate", "master_rat
          "queue_size", "error_actions", "state_file")
 
 
-def unknown_params(names: List[str], node: str) -> List[str]:
-    """A warning for each private parameter of `node` (full names from the master) that the monitor
-    does not read (a typo such as `_rat:=5` would otherwise be silently ignored)."""
+def unknown_params(names: List[str], node: str, known: Sequence[str] = KNOWN) -> List[str]:
+    """A warning for each private parameter of `node` (full names from the master) that it does
+    not read, `known` (a typo such as `_rat:=5` would otherwise be silently ignored)."""
     prefix = node.rstrip("/") + "/"
     # a leaf right under the node; a group deeper down is another node's (an agent in ns="rubass")
     found = sorted({n[len(prefix):] for n in names if n.startswith(prefix) and "/" not in n[len(prefix):]}
-                   - set(KNOWN) - {""})
-    return [f"unknown parameter ~{n} (ignored){did_you_mean('~' + n, ['~' + k for k in KNOWN])}" for n in found]
+                   - set(known) - {""})
+    return [f"unknown parameter ~{n} (ignored){did_you_mean('~' + n, ['~' + k for k in known])}" for n in found]
 
 
 def read_rate(get: Getter, name: str, default: float, lo: float, hi: float) -> float:

@@ -90,3 +90,14 @@ def test_an_unreachable_master_is_reported_with_how_long(monkeypatch):
     results, registered, watch = run(monkeypatch, [OSError("down")] * 3)
     assert results == ["unreachable"] * 3 and registered == []
     assert watch.state.startswith("unreachable for")
+
+
+def test_the_state_says_unreachable_before_the_log_line_is_written():
+    """Acceptance finding (two network namespaces): with the master's host cut off, rospy's log
+    call blocked until the link was back, and the state, set after it, read 'connected' all along."""
+    states = []
+    watch = MasterWatch("/rubass", ME, "http://master:11311", 0.25,
+                        lambda level, text: states.append(watch.state))  # what /diagnostics reads while it logs
+    watch._caller = ScriptedMaster([OSError("timed out")])
+    assert watch.check() == "unreachable"
+    assert len(states) == 1 and states[0].startswith("unreachable for"), states
