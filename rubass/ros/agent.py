@@ -142,8 +142,10 @@ def main(argv: Optional[List[str]] = None) -> int:
     from std_msgs.msg import String
 
     from .master_watch import MasterWatch
+    from .rosout_param import keep_rosout_flag
 
     rospy.init_node(default_name(), argv=argv)
+    keep_rosout_flag()  # no log call asks the master anything (one would block while its host is cut off)
     log: Log = lambda level, text: {"debug": rospy.logdebug, "info": rospy.loginfo,  # noqa: E731
                                     "warn": rospy.logwarn, "error": rospy.logerr}[level](text)
     try:

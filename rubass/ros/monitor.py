@@ -66,6 +66,7 @@ from .clockjump import ClockJump
 from ..actions.errorguard import ErrorGuard
 from ..actions.keeper import LatchKeeper
 from ..actions.latches import LatchFile, adopt_old_default, default_path
+from .rosout_param import keep_rosout_flag
 from .params import MonitorConfig, ParamError, read_config, spec_warnings, unknown_params
 from .gcfreeze import freeze_heap
 from .timerslack import exact_timers
@@ -454,6 +455,7 @@ class Monitor(Reloading):
 
 def main(argv: Optional[List[str]] = None) -> int:
     rospy.init_node("rubass", argv=argv, disable_signals=True)  # Monitor handles SIGINT/SIGTERM
+    keep_rosout_flag()  # no log call asks the master anything (one would block while its host is cut off)
     sys.setswitchinterval(0.0005)  # a busy thread must not delay a deadline by the default 5 ms
     try:
         names = rospy.get_param_names()
