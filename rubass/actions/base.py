@@ -5,8 +5,8 @@ from __future__ import annotations
 import importlib
 import importlib.util
 import inspect
+import linecache
 import os
-import re
 import sys
 import sysconfig
 from dataclasses import dataclass, field
@@ -14,7 +14,6 @@ from typing import Any, Dict, List, Optional, Tuple
 
 from ..lang.errors import Diagnostic
 from ..lang.library import ActionDef
-from ..lang.source import Span
 
 
 class ActionSetupError(Exception):
@@ -125,10 +124,12 @@ class CustomPlugin(ActionPlugin):
 
     def _error(self, text: str) -> ActionSetupError:
         """The error as `rubass check` prints a library's: FILE:LINE:COL of its `plugin:` entry, the line, a caret."""
-        span, line = plugin_place(self.action)
+        span = self.action.plugin_span  # where the library's YAML had it (an anchor's, for a merged one)
         message = f"action '{self.name}': {text}"
         if span.line <= 0:  # an action made in code, not read from a library
             return ActionSetupError(message)
+        linecache.checkcache(span.file)  # the file as it is now (a reload may have edited it)
+        line = linecache.getline(span.file, span.line).rstrip("\n")
         return ActionSetupError(Diagnostic(span, message, line_text=line).render())
 
     def setup(self) -> None:
@@ -175,30 +176,6 @@ def make_plugin(action: ActionDef) -> ActionPlugin:
         return CustomPlugin(action)
     module, _, cls = BUILTIN[action.plugin].partition(":")
     return getattr(importlib.import_module(module), cls)(action)  # type: ignore[no-any-return]
-
-
-def plugin_place(action: ActionDef) -> Tuple[Span, str]:
-    """Where the action's `plugin:` value is in its library, and that line; the action's own place
-    (its name) when the library cannot be read again or the value is not found under it."""
-    span = action.span
-    try:
-        with open(span.file, encoding="utf-8", errors="replace") as f:
-            lines = f.read().splitlines()
-    except (OSError, ValueError):
-        return span, ""
-    if not 1 <= span.line <= len(lines):
-        return span, ""
-    value = re.compile(r"\bplugin\s*:\s*(?P<v>[\"']?" + re.escape(action.plugin) + ")")
-    indent = span.col - 1
-    for i in range(span.line - 1, len(lines)):
-        text = lines[i]
-        if i > span.line - 1 and text.strip() and not text.lstrip().startswith("#") \
-                and len(text) - len(text.lstrip()) <= indent:
-            break  # the next action: this one's mapping is over
-        m = value.search(text, indent if i == span.line - 1 else 0)
-        if m:
-            return Span(span.file, i + 1, m.start("v") + 1), text
-    return span, lines[span.line - 1]
 
 
 def _is_standard_library(module_name: str) -> bool:

@@ -40,6 +40,7 @@ class ActionDef:
     latch: bool = False
     span: Span = field(default=Span("<none>", 0, 0), compare=False)
     priority: int = 0  # among actions publishing on the same topic, the highest publishes (§16)
+    plugin_span: Span = field(default=Span("<none>", 0, 0), compare=False)  # its `plugin:` value
 
     @property
     def is_custom(self) -> bool:
@@ -345,7 +346,7 @@ def _action(name: str, span: Span, node: _Node, file: str) -> Tuple[Optional[Act
         return None, diags
     latch = bool(params.pop("latch", False))
     priority = int(params.pop("priority", 0))
-    return ActionDef(name, plugin, params, latch, span, priority), []
+    return ActionDef(name, plugin, params, latch, span, priority, pnode.span), []
 
 
 def _limit_problems(where: str, span: Span, params: Dict[str, Any], fields: Dict[str, Any]) -> List[Diagnostic]:

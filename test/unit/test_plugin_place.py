@@ -52,3 +52,10 @@ def test_a_class_missing_from_its_module_and_a_failing_setup_are_named_at_their_
     with pytest.raises(ActionSetupError, match=rf"^{path}:3:15: error: action 'b': robot_plug_place:Bad.setup\(\) "
                                                "failed: ValueError: no horn on this robot"):
         plugin.setup()
+
+
+def test_a_merged_plugin_entry_is_named_where_the_anchor_gives_it(tmp_path):
+    path, actions = load(tmp_path, "actions:\n  horn: &h\n    plugin: robot_pkg_missing.horn:Horn\n"
+                                   "  horn2:\n    <<: *h\n    a: 2\n")
+    with pytest.raises(ActionSetupError, match=rf"^{path}:3:13: error: action 'horn2': cannot import"):
+        make_plugin(actions["horn2"])
