@@ -23,6 +23,7 @@ from .source import SourceSet, Span
 from .typecheck import ANY, ExprChecker, Resolution, Scope, Ty
 
 STAMP_PATH: Tuple[ast.PathElem, ...] = ("header", "stamp")
+UNUSED_ACTION = "unused action "  # the subject of that warning, then the action's name
 
 
 class _Checker:
@@ -311,7 +312,8 @@ class _Checker:
                                         self.attrs.own(d.attrs, "behaviour")))
         for name, span in declared.items():
             if name not in used:
-                self.warnings.append(Diagnostic(span, f"action '{name}' is declared but never used", "warning"))
+                self.warnings.append(Diagnostic(span, f"action '{name}' is declared but never used", "warning",
+                                                subject=UNUSED_ACTION + name))
         return out
 
 

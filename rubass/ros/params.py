@@ -2,10 +2,10 @@
 from __future__ import annotations
 
 import os
-import re
 from dataclasses import dataclass, field
 from typing import Any, Callable, List, Optional, Sequence
 
+from ..lang.checker import UNUSED_ACTION
 from ..lang.errors import Diagnostic, RubassError, did_you_mean
 from ..lang.units import FREQUENCY, parse_quantity
 
@@ -108,16 +108,8 @@ def read_config(get: Getter, default_state_file: Optional[str] = None) -> Monito
     )
 
 
-_UNUSED = re.compile(r"action '([^']+)' is declared but never used")
-
-
 def spec_warnings(warnings: List[Diagnostic], config: MonitorConfig) -> List[Diagnostic]:
     """The spec's warnings that hold for the monitor: an action that only ~overload_actions or
     ~error_actions names is used (by them), not 'declared but never used'."""
-    used = set(config.overload_actions) | set(config.error_actions)
-    out = []
-    for w in warnings:
-        m = _UNUSED.fullmatch(w.message)
-        if not (m and m.group(1) in used):
-            out.append(w)
-    return out
+    used = {UNUSED_ACTION + a for a in list(config.overload_actions) + list(config.error_actions)}
+    return [w for w in warnings if w.subject not in used]
