@@ -39,10 +39,6 @@ def _rate(text: str) -> float:
     return value
 
 
-def _global(name: str) -> str:
-    return name if name.startswith("/") else "/" + name.lstrip("~")
-
-
 def _sampled_nodes(samples: Iterable[Tuple[float, str, Any]]) -> Set[str]:
     """The nodes that a monitor's recorded ~node_samples cover."""
     out: Set[str] = set()
@@ -139,7 +135,7 @@ def run(args: argparse.Namespace) -> int:
             except BagError as exc:
                 print(f"rubass replay: error: {exc}", file=sys.stderr)
                 return 1
-            stream = agent_samples(stream, set(agent_topics), {_global(n): n for n in spec.nodes}, skip, info.end)
+            stream = agent_samples(stream, set(agent_topics), {resolve(n): n for n in spec.nodes}, skip, info.end)
             node_topics = node_topics + [SAMPLES]
         try:
             with _fewer_collections():
@@ -168,6 +164,9 @@ def run(args: argparse.Namespace) -> int:
     return 0
 
 
+PLOT_FORMATS = ("png", "pdf", "svg", "jpg", "jpeg")
+
+
 def plot_path(path: str) -> str:
     """The timeline's file: .png when it names no format; an argparse error for a folder or a
     format matplotlib cannot write (checked before the replay, not after it)."""
@@ -180,6 +179,3 @@ def plot_path(path: str) -> str:
         raise argparse.ArgumentTypeError(f"cannot write a timeline as '.{ext}': use one of "
                                          f"{', '.join('.' + f for f in PLOT_FORMATS)}")
     return path
-
-
-PLOT_FORMATS = ("png", "pdf", "svg", "jpg", "jpeg")

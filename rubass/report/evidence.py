@@ -13,7 +13,7 @@ from ..engine import Event
 from ..lang import ast
 from ..lang.attributes import entity_ids, rule_ids
 from ..lang.model import CheckedSpec
-from ..lang.topicnames import spellings
+from ..lang.topicnames import resolve, spellings
 from ..testing.coverage import Coverage, coverage
 from ..testing.results import FileResult
 from ..testing.runner import Outcome
@@ -215,7 +215,7 @@ def replay_bag(spec: CheckedSpec, path: str, rate: float = 50.0) -> BagRun:
                 from ..replay.command import _sampled_nodes
 
                 skip = _sampled_nodes(read(bag, node_topics, set(node_topics)))
-                nodes = {(n if n.startswith("/") else "/" + n): n for n in spec.nodes}
+                nodes = {resolve(n): n for n in spec.nodes}
                 stream = agent_samples(stream, set(agent_topics), nodes, skip, info.end)
                 node_topics = node_topics + [SAMPLES]
             _, run.events = replay(spec, stream, info.start, info.end, rate, node_topics)

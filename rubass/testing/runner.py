@@ -14,7 +14,7 @@ from ..engine import Event
 from ..lang.ast import path_suffix
 from ..lang.errors import did_you_mean
 from ..lang.model import CheckedSpec
-from ..lang.topicnames import spellings
+from ..lang.topicnames import resolve, spellings
 from ..replay.run import replay
 from .format import UNSET, Case, Expect, MessageInput
 from .messages import MessageError, assign, has_header
@@ -49,10 +49,6 @@ class _Sample:
 
     def __init__(self, data: str) -> None:
         self.data = data
-
-
-def _global(name: str) -> str:
-    return name if name.startswith("/") else "/" + name.lstrip("~")
 
 
 def _absolute(stamp: Any) -> Any:
@@ -125,9 +121,9 @@ def _stream(spec: CheckedSpec, case: Case, path: str, warnings: List[str]) -> Li
         for name in names.get(topic, ()):
             out.append((EPOCH + time, 0, name, msg))
     state: Dict[str, Dict[str, Any]] = {}
-    nodes = {_global(n): n for n in spec.nodes}
+    nodes = {resolve(n): n for n in spec.nodes}  # as the monitor resolves them
     for s in sorted(case.nodes, key=lambda s: s.time):
-        node = s.node if s.node in spec.nodes else nodes.get(_global(s.node))
+        node = s.node if s.node in spec.nodes else nodes.get(resolve(s.node))
         if node is None:
             warnings.append(f"{path}:{s.line}: warning: the spec names no node {s.node}"
                             f"{did_you_mean(s.node, spec.nodes)}; its samples change nothing")
