@@ -132,7 +132,6 @@ def _quantity(d: Dimension, unit: str, example: str) -> Checker:
     return check
 
 
-
 def _range(d: Dimension, unit: str) -> Checker:
     """[min, max] with units of dimension d (a bare 0 needs none); SI floats, min <= max."""
     units = _UNITS_OF[unit]

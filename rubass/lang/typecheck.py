@@ -347,7 +347,6 @@ class ExprChecker(BuiltinChecks):
             self.error(span, template.format(a_noun(dimension_name(a.dim)), a_noun(dimension_name(b.dim))))
 
 
-
 def _join(a: Ty, b: Ty) -> Ty:
     """The type of a + b (already checked compatible)."""
     if a.kind != "num" or b.kind != "num":  # a topic field takes the dimension of what it meets
