@@ -79,19 +79,25 @@ tests:
     assert "warning: the spec reads no topic /p" in err, err
 
 
-def test_replay_feeds_every_spelling_of_a_topic(write, tmp_path, capsys):
+def spellings_bag(tmp_path):
+    """/x: 0, 2 at 0.5 s, 0 at 2 s; /rubass/p (the spec's ~p): 2 at 1 s."""
     rosbag = pytest.importorskip("rosbag")
     import rospy
     from std_msgs.msg import Float64
 
-    write("lib.yaml", LIB)
-    spec = write("robot.rbs", SPEC)
     bag = str(tmp_path / "x.bag")
     with rosbag.Bag(bag, "w") as b:
         b.write("/x", Float64(0.0), rospy.Time.from_sec(100.0))
         b.write("/x", Float64(2.0), rospy.Time.from_sec(100.5))
         b.write("/rubass/p", Float64(2.0), rospy.Time.from_sec(101.0))
         b.write("/x", Float64(0.0), rospy.Time.from_sec(102.0))
+    return bag
+
+
+def test_replay_feeds_every_spelling_of_a_topic(write, tmp_path, capsys):
+    write("lib.yaml", LIB)
+    spec = write("robot.rbs", SPEC)
+    bag = spellings_bag(tmp_path)
     code, out, err = run(capsys, "replay", spec, bag, "--json")
     assert code == 0, out + err
     assert "warning" not in err, err
@@ -142,21 +148,12 @@ tests:
 
 def test_the_report_replays_every_spelling_of_a_topic(write, tmp_path):
     """rubass report --bag replays as rubass replay does: each spelling fed (helper finding)."""
-    rosbag = pytest.importorskip("rosbag")
-    import rospy
-    from std_msgs.msg import Float64
-
     from rubass.lang import load_spec
     from rubass.report.evidence import replay_bag
 
     write("lib.yaml", LIB)
     spec = load_spec(write("robot.rbs", SPEC))
-    bag = str(tmp_path / "x.bag")
-    with rosbag.Bag(bag, "w") as b:
-        b.write("/x", Float64(0.0), rospy.Time.from_sec(100.0))
-        b.write("/x", Float64(2.0), rospy.Time.from_sec(100.5))
-        b.write("/rubass/p", Float64(2.0), rospy.Time.from_sec(101.0))
-        b.write("/x", Float64(0.0), rospy.Time.from_sec(102.0))
+    bag = spellings_bag(tmp_path)
     run = replay_bag(spec, bag)
     assert not run.error and not run.warnings, (run.error, run.warnings)
     starts = sorted((e.behaviour, round(e.time, 3)) for e in run.events if e.kind == "start")
