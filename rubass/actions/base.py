@@ -42,7 +42,8 @@ class Context:
 class ActionStats:
     calls: int = 0
     failures: int = 0
-    last_error: str = ""
+    last_error: str = ""  # the latest failure, kept for the record once resolved (RESOLVED prefix)
+    failing: str = ""  # the phase whose latest attempt failed ("start", "input", …); "" when none
     extra: Dict[str, Any] = field(default_factory=dict)
 
 

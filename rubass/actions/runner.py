@@ -136,6 +136,7 @@ class ActionRunner:
                 return
             except Exception as exc:  # a bug in the runner itself must not end the action silently
                 self.stats.failures += 1
+                self.stats.failing = "runner"
                 self.stats.last_error = f"runner: {exc.__class__.__name__}: {exc}"
                 self.log("error", f"action '{self.plugin.name}': its runner failed ({exc.__class__.__name__}: "
                                   f"{exc}); going on")
@@ -200,6 +201,7 @@ class ActionRunner:
             fn()
         except Exception as exc:  # a plugin's failure must never reach the engine
             self.stats.failures += 1
+            self.stats.failing = what
             self.stats.last_error = f"{what}: {exc.__class__.__name__}: {exc}"
             now = time.monotonic()
             if now - self._last_log >= LOG_EVERY:
@@ -217,12 +219,10 @@ class ActionRunner:
         Only a success that answers the failure resolves it: the same phase again, or the phase that
         made it moot (a release after a failed start); a hold that wrote nothing says nothing of a
         device that periodic() found away, nor a periodic() of a failed start."""
-        error = self.stats.last_error
-        if not error or error.startswith(RESOLVED):
+        failed, error = self.stats.failing, self.stats.last_error
+        if not failed or what not in _RESOLVED_BY.get(failed, ("start", "hold", "release")):
             return
-        failed = error.split(":", 1)[0]
-        if what not in _RESOLVED_BY.get(failed, ("start", "hold", "release")):
-            return
+        self.stats.failing = ""
         self.stats.last_error = RESOLVED + error
-        if not error.startswith("input:"):  # a plugin's own bad-input count is logged by the plugin
+        if failed != "input":  # a plugin's own bad-input count is logged by the plugin
             self.log("info", f"action '{self.plugin.name}' {what} succeeded after failing ({error})")

@@ -5,7 +5,7 @@ Pure: built from plain snapshots, so it is tested without ROS.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Any, Dict, List, Tuple
+from typing import Any, Dict, List, Sequence, Tuple
 
 from ..lang import ast
 from ..lang.model import CheckedSpec
@@ -52,8 +52,9 @@ def unknown_reasons(spec: CheckedSpec, rule_key: str, topics: Dict[str, Dict[str
 
 def build(spec: CheckedSpec, rules: Dict[str, Any], active: List[int], topics: Dict[str, Dict[str, Any]],
           nodes: Dict[str, Dict[str, Any]], field_errors: Dict[Tuple[str, str], str],
-          monitor: Dict[str, Any]) -> List[Entry]:
-    """Entries for every entity (WARN while one of its rules is true, ERROR on data errors) and the monitor."""
+          monitor: Dict[str, Any], failing: Sequence[Tuple[str, str]] = ()) -> List[Entry]:
+    """Entries for every entity (WARN while one of its rules is true, ERROR on data errors) and the
+    monitor; `failing`: (name, error) of the actions whose latest attempt failed (ERROR meanwhile)."""
     out: List[Entry] = []
     by_entity: Dict[str, List[str]] = {}
     for r in spec.rules:
@@ -85,7 +86,6 @@ def build(spec: CheckedSpec, rules: Dict[str, Any], active: List[int], topics: D
         out.append(Entry(f"rubass: {entity}", level, msg, values))
     mvalues = [(k, str(v)) for k, v in monitor.items()]
     mvalues.append(("active behaviours", ", ".join(str(i) for i in active) or "none"))
-    failing = failing_actions(monitor)  # "action failures" counts every failure ever: only a record
     level = ERROR if monitor.get("last reload error") or failing else OK
     if monitor.get("latch state error"):  # a latched stop may not survive a restart, or one was restored blind
         level = ERROR
@@ -112,14 +112,6 @@ def build(spec: CheckedSpec, rules: Dict[str, Any], active: List[int], topics: D
     msg += msg_latch
     out.append(Entry("rubass: monitor", level, msg, mvalues))
     return out
-
-
-def failing_actions(monitor: Dict[str, Any]) -> List[Tuple[str, str]]:
-    """(name, error) of the actions whose latest attempt failed: the monitor's "action NAME" values
-    that a later success has not marked RESOLVED."""
-    return [(key[len("action "):], value) for key, value in monitor.items()
-            if key.startswith("action ") and key != "action failures" and isinstance(value, str) and value
-            and not value.startswith(RESOLVED)]
 
 
 def not_enforcing(spec_path: str, error: str, reloads: int, rejected: int) -> List[Entry]:

@@ -392,7 +392,7 @@ class Monitor(Reloading):
             "coalesced reload requests": self.coalesced,
             "last reload error": self.last_reload_error, "dropped messages": loop.dropped,
             "overloaded": "running " + ", ".join(self.overload.actions) if self.overload.active else "no",
-            "action failures": failures,
+            "failed action attempts": failures,  # every one ever, for the record (no action name has a space)
             "master": self.master_watch.state, "master re-registrations": self.master_watch.reregistrations,
             "reaction latency p50 ms": f"{lat[len(lat) // 2] * 1000:.3f}" if lat else "n/a",
             "agents": self.agents.summary(time.monotonic()),
@@ -401,6 +401,7 @@ class Monitor(Reloading):
         for name, r in self.runners.items():
             if r.stats.last_error:
                 monitor[f"action {name}"] = r.stats.last_error
+        failing = [(name, r.stats.last_error) for name, r in self.runners.items() if r.stats.failing]
         monitor.update(self.keeper.status())
         monitor["clock jumps back"] = loop.clock_jumps
         if loop.dropped_by_topic:
@@ -410,7 +411,7 @@ class Monitor(Reloading):
         if self.error_guard.active:
             monitor["data error actions"] = "running " + ", ".join(self.error_guard.actions)
         assert self.spec is not None
-        entries = status_mod.build(self.spec, rules, active, topics, nodes, field_errors, monitor)
+        entries = status_mod.build(self.spec, rules, active, topics, nodes, field_errors, monitor, failing)
         self.outputs.status(entries, _ros_now())
 
     def shutdown(self) -> None:

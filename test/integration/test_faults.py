@@ -178,7 +178,7 @@ def test_a_stop_topic_without_subscriber_is_logged_retried_and_reaches_a_late_su
     last = [s for r in rec if r["kind"] == "recv" for s in r["msg"]["status"] if s["name"] == "rubass: monitor"][-1]
     values = {kv["key"]: kv["value"] for kv in last["values"]}
     assert last["level"] in (0, b"\x00"), last
-    assert int(values["action failures"]) >= 1 and values["action stop"].startswith("resolved"), values
+    assert int(values["failed action attempts"]) >= 1 and values["action stop"].startswith("resolved"), values
 
 
 def test_a_serial_board_that_vanishes_and_comes_back_gets_the_stop_it_missed(ros, tmp_path):

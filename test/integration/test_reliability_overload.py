@@ -51,7 +51,7 @@ def test_a_stop_that_reaches_no_subscriber_is_retried_with_backoff_not_a_spin(ro
                      "steps": [{"wait": "/diagnostics", "timeout": 5}]})
     values = {kv["key"]: kv["value"] for s in first(rec, "recv", "/diagnostics")["msg"]["status"]
               for kv in s["values"]}
-    assert 2 <= int(values["action failures"]) <= 30, values  # 0.05, 0.1, 0.2, 0.5 s, then 1 s: counted
+    assert 2 <= int(values["failed action attempts"]) <= 30, values  # 0.05, 0.1, 0.2, 0.5 s, then 1 s: counted
     assert "no node subscribes" in values["action stop"]
     # the periodic output went on: a subscriber that comes now gets the stop within a period or two
     late = ros.probe({"listen": [{"topic": "/safety_cmd", "type": TWIST}], "steps": [{"wait": "/safety_cmd",

@@ -172,8 +172,9 @@ def test_a_failure_is_marked_resolved_by_the_next_success_and_the_monitor_is_ok_
 
     def monitor_level():
         spec = check_text("entity base { rules: fast: topic /cmd_vel.linear.x > 1; }\n")
-        monitor = {"action failures": r.stats.failures, "action stop": r.stats.last_error}
-        return status.build(spec, {"base.fast": False}, [], {}, {}, {}, monitor)[-1].level
+        monitor = {"failed action attempts": r.stats.failures, "action stop": r.stats.last_error}
+        failing = [("stop", r.stats.last_error)] if r.stats.failing else []
+        return status.build(spec, {"base.fast": False}, [], {}, {}, {}, monitor, failing)[-1].level
 
     try:
         r.submit("start", Context(1, 3))
@@ -250,6 +251,7 @@ def test_a_bad_input_is_not_resolved_by_the_runners_phases():
     try:
         r.submit("start", Context(1, 3))
         p.stats.last_error = "input: /cmd_vel carries std_msgs/String, not geometry_msgs/Twist"
+        p.stats.failing = "input"
         for _ in range(5):
             r.submit("hold", Context(1, 3))
             time.sleep(0.02)
@@ -257,6 +259,6 @@ def test_a_bad_input_is_not_resolved_by_the_runners_phases():
         while len([c for c in p.calls if c[0] == "hold"]) < 2 and time.monotonic() < end:
             time.sleep(0.01)
         assert len([c for c in p.calls if c[0] == "hold"]) >= 2
-        assert r.stats.last_error.startswith("input: ")
+        assert r.stats.last_error.startswith("input: ") and r.stats.failing == "input"
     finally:
         r.stop()

@@ -5,9 +5,9 @@ from rubass.actions import status
 SPEC = "entity base { rules: fast: topic /cmd_vel.linear.x > 1; }\n"
 
 
-def monitor_entry(**monitor):
+def monitor_entry(failing=(), **monitor):
     spec = check_text(SPEC)
-    entries = status.build(spec, {"base.fast": False}, [], {}, {}, {}, monitor)
+    entries = status.build(spec, {"base.fast": False}, [], {}, {}, {}, monitor, failing)
     return entries[-1]
 
 
@@ -33,13 +33,21 @@ def test_an_overloaded_monitor_is_error_and_names_the_fail_safe_actions():
 
 def test_an_action_failure_is_error_only_until_a_later_attempt_succeeds():
     """A stop that reached no subscriber once, then did: the count stays on record, the level is OK."""
-    failing = monitor_entry(**{"action failures": 3, "action stop2": "start: OSError: no node subscribes to /x"})
+    error = "start: OSError: no node subscribes to /x"
+    failing = monitor_entry([("stop2", error)], **{"failed action attempts": 3, "action stop2": error})
     assert failing.level == status.ERROR
     assert "ACTION FAILING: stop2: start: OSError: no node subscribes to /x" in failing.message
-    resolved = monitor_entry(**{"action failures": 3,
-                                "action stop2": status.RESOLVED + "start: OSError: no node subscribes to /x"})
+    resolved = monitor_entry(**{"failed action attempts": 3, "action stop2": status.RESOLVED + error})
     assert resolved.level == status.OK and "FAILING" not in resolved.message
-    assert ("action failures", "3") in resolved.values
+    assert ("failed action attempts", "3") in resolved.values
+
+
+def test_an_action_named_failures_is_not_confused_with_the_count_of_failures():
+    """Its error is its own value, the count another; failing or not is the runner's state, not text."""
+    e = monitor_entry([("failures", "start: OSError: away")],
+                      **{"failed action attempts": 2, "action failures": "start: OSError: away"})
+    assert e.level == status.ERROR and "ACTION FAILING: failures: start: OSError: away" in e.message
+    assert ("failed action attempts", "2") in e.values and ("action failures", "start: OSError: away") in e.values
 
 
 def test_a_type_change_shows_the_rule_and_field_it_breaks_first():

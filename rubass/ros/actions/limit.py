@@ -159,15 +159,16 @@ class LimitPlugin(ActionPlugin):
 
     def _input_ok(self) -> None:
         """A well-typed command came: a bad-input error no longer makes /diagnostics ERROR."""
-        error = self.stats.last_error
-        if error.startswith("input:"):
-            self.stats.last_error = RESOLVED + error
+        if self.stats.failing == "input":
+            self.stats.failing = ""
+            self.stats.last_error = RESOLVED + self.stats.last_error
 
     def _fail(self, text: str) -> None:
         """A bad input is no command (the timeout turns it into zero): counted in /diagnostics,
         logged at most every 5 s."""
         self.input_errors += 1
         self.stats.failures += 1
+        self.stats.failing = "input"
         self.stats.last_error = f"input: {text}"
         now = time.monotonic()
         if now - self._last_log >= LOG_EVERY:
