@@ -139,12 +139,31 @@ def parse_model(src: Source) -> Tuple[Optional[SystemModel], List[Diagnostic]]:
         try:
             model.registry.add(parse_msg(ty, text))
         except DefinitionError as exc:
-            r.error(vnode, f"the definition of {ty}: {exc}")
+            place = _definition_line(src, vnode, exc.line)
+            if place is None:
+                r.error(vnode, f"the definition of {ty}: {exc}")
+            else:
+                r.diags.append(Diagnostic(place, f"the definition of {ty}: {exc}"))
     if "source" in entries:
         text = r.string(entries["source"][1], "'source'")
         if text:
             model.source = f"the system model {src.name} (from {text})"
     return (None, r.diags) if r.diags else (model, [])
+
+
+def _definition_line(src: Source, node: yaml.Node, line: int) -> Optional[Span]:
+    """Where line `line` of a definition written as a literal block (`Type: |`) is in the file;
+    None for another style, whose lines are not the file's."""
+    if not line or not isinstance(node, yaml.ScalarNode) or node.style != "|":
+        return None
+    lines = src.text.splitlines(True)
+    index = node.start_mark.line + line  # 0-based: the block starts on the line after its '|'
+    if index >= len(lines):
+        return None
+    start = sum(len(x) for x in lines[:index])
+    text = lines[index]
+    col = len(text) - len(text.lstrip(" "))
+    return Span(src.name, index + 1, col + 1, start + col, start + len(text.rstrip("\r\n")))
 
 
 def load_model(path: str, sources: SourceSet) -> Tuple[Optional[SystemModel], List[Diagnostic]]:

@@ -21,6 +21,10 @@ _SEPARATOR = re.compile(r"^={10,}\s*$", re.M)
 class DefinitionError(RubassError, ValueError):
     """A definition that cannot be parsed; the message names the type and the line."""
 
+    def __init__(self, message: str, line: int = 0) -> None:
+        super().__init__(message)
+        self.line = line  # 1-based line within the definition's text; 0: the definition as a whole
+
 
 @dataclass(frozen=True)
 class FieldDef:
@@ -80,7 +84,7 @@ def parse_msg(type_name: str, text: str) -> MsgSpec:
             continue
         m = _FIELD.match(line)
         if m is None:
-            raise DefinitionError(f"{type_name}: line {number}: cannot read '{raw.strip()}'")
+            raise DefinitionError(f"{type_name}: line {number}: cannot read '{raw.strip()}'", number)
         ftype, arr, size, name, const = m.groups()
         if const is not None:  # a constant, e.g. `uint8 POWER_SUPPLY_STATUS_UNKNOWN = 0`
             continue

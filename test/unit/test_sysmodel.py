@@ -193,7 +193,10 @@ def test_hand_written_model_file():
     ("topics:\n  /a: {type: a/B, units: {x: cm}}\n", "robot.yaml:2:30", "'cm' is not an SI unit"),
     ("topics: {}\ntopic: {}\n", "robot.yaml:2:1", "unknown key 'topic'; did you mean 'topics'?"),
     ("nodes: []\n", "robot.yaml:1:1", "needs a key 'topics'"),
-    ("topics: {}\ndefinitions:\n  a/B: |\n    float64 x y z\n", "robot.yaml:3:8", "the definition of a/B"),
+    ("topics: {}\ndefinitions:\n  a/B: |\n    float64 x y z\n", "robot.yaml:4:5", "the definition of a/B"),
+    # the bad line of a block, not its 'Type: |' line
+    ("topics: {}\ndefinitions:\n  a/B: |\n    float64 x\n\n    # c\n    flot64[ y\n", "robot.yaml:7:5", "line 4: cannot read"),
+    ("topics: {}\ndefinitions:\n  a/B: \"float64 x y z\"\n", "robot.yaml:3:8", "the definition of a/B"),
     ("topics: {a: [\n", "robot.yaml:2:1", "invalid YAML"),
     ("topics: {}\nnodes: 3\n", "robot.yaml:2:8", "'nodes' must be a list"),
     ("topics:\n  /a: !foo x\n", "robot.yaml:2:7", "YAML tag '!foo' is not allowed"),
