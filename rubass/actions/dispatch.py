@@ -68,8 +68,8 @@ class Dispatcher:
             source, latency = f"node sample of {cause.node}", None
         elif cause == "reset":
             source, latency = "reset service", None
-        elif cause == "reload":
-            source, latency = "reload", None
+        elif cause in ("reload", "shutdown"):
+            source, latency = cause, None
         else:
             source, latency = "deadline", max(0.0, self.ros_now() - e.time)
         if e.kind == "start" and latency is not None:

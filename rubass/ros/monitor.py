@@ -431,6 +431,7 @@ class Monitor(Reloading):
                 b = engine.spec.behaviours[index - 1]
                 if not b.latched:
                     self.dispatcher.release(b, keys[index], now)
+                    self.dispatcher.report_event(Event(now, "release", index), b, (), "shutdown")  # pairs its start
             if not any(engine.spec.actions[a].latch for a in self.overload.actions):
                 self.overload.release(now, self.dispatcher.runners, "the monitor stops")
             if not any(engine.spec.actions[a].latch for a in self.error_guard.actions):

@@ -1,4 +1,5 @@
 """The monitor on a live ROS 1 system: a real master per test, real publishers in other processes."""
+import json
 import os
 import signal
 import subprocess
@@ -202,9 +203,11 @@ def test_bad_params_exit_non_zero_before_subscribing(ros, tmp_path, params, mess
 
 
 def test_sigterm_releases_non_latched_actions_and_exits_0(ros, tmp_path):
+    """...and reports each release on ~events (cause "shutdown"), so every start there has its release."""
     lib = LIB.replace("message: {data: true}, rate: 20 Hz}", "message: {data: true}, on_release: {data: false}, rate: 20 Hz}")
     mon = ros.monitor(spec(tmp_path, "entity a { rules: r: topic /x.data > 1; }\nif (a.r) then { brake; }\n", lib=lib))
-    listener = ros.probe_bg({"listen": [{"topic": "/brake", "type": "std_msgs/Bool"}],
+    listener = ros.probe_bg({"listen": [{"topic": "/brake", "type": "std_msgs/Bool"},
+                                        {"topic": "/rubass/events", "type": "std_msgs/String"}],
                              "advertise": [{"topic": "/x", "type": "std_msgs/Float64"}],
                              "steps": [{"wait_subscribers": "/x"}, {"wait_publishers": "/brake"}, {"sleep": 0.3},
                                        {"publish": "/x", "msg": {"data": 5.0}}, {"sleep": 0.5}, {"mark": "active"},
@@ -218,8 +221,10 @@ def test_sigterm_releases_non_latched_actions_and_exits_0(ros, tmp_path):
     assert any('"recv"' in line for line in seen), "the brake was active before the signal"
     mon.send_signal(signal.SIGTERM)
     assert mon.wait(10) == 0, ros.log(mon)
-    rec = records(listener)
-    assert [r["msg"]["data"] for r in rec if r["kind"] == "recv"][-1] is False, ros.log(mon)
+    rec = [json.loads(line) for line in seen if line.startswith("{")] + records(listener)
+    assert [r["msg"]["data"] for r in rec if r["kind"] == "recv" and r["topic"] == "/brake"][-1] is False, ros.log(mon)
+    events = [json.loads(r["msg"]["data"]) for r in rec if r["kind"] == "recv" and r["topic"] == "/rubass/events"]
+    assert [(e["event"], e["cause"]) for e in events] == [("start", "message on /x"), ("release", "shutdown")], events
 
 
 def test_a_missing_field_is_an_error_in_log_and_status_and_the_monitor_keeps_running(ros, tmp_path):
