@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import os
 from dataclasses import dataclass, field
-from typing import Any, Dict, List, Optional, Sequence, Set, Tuple
+from typing import Any, Dict, FrozenSet, List, Optional, Sequence, Set, Tuple
 
 import yaml
 
@@ -238,33 +238,44 @@ def spec_text(spec: CheckedSpec, span: Any) -> str:
         return ""
 
 
-def design_times(expr: ast.Expr) -> List[float]:
-    """The `for` / `within` durations of an expression (its own reaction time by design)."""
-    out = []
-    for e in ast.walk(expr):
-        dur = getattr(e, "duration", None)
-        if isinstance(dur, ast.Lit) and isinstance(dur.value, float):
-            out.append(dur.value)
-    return out
+def design_chain(spec: CheckedSpec, expr: ast.Expr, _seen: FrozenSet[Any] = frozenset()) -> List[float]:
+    """The times on an expression's longest path from its inputs to its value (its reaction by
+    design): a `for` adds its time to its operand's; an `age(…) > T` adds T (from the last
+    message); `active(A)` takes the slowest behaviour that starts A; a rule reference the rule's
+    own; `within` and `latch` add nothing (true at once); of several operands, the slowest."""
+    if isinstance(expr, ast.For):
+        return design_chain(spec, expr.operand, _seen) + [_seconds_of(expr.duration)]
+    if isinstance(expr, ast.Within):
+        return design_chain(spec, expr.operand, _seen)
+    if isinstance(expr, ast.Latch):
+        return design_chain(spec, expr.set, _seen)
+    if isinstance(expr, ast.RuleRef):
+        if expr.key in _seen:
+            return []
+        return design_chain(spec, spec.rule(expr.key).expr, _seen | {expr.key})
+    if isinstance(expr, ast.Active):
+        paths = [design_chain(spec, b.cond, _seen | {b.index}) for b in spec.behaviours
+                 if b.index not in _seen and any(a.name == expr.action for a in b.actions)]
+        return max(paths, key=sum, default=[])
+    if isinstance(expr, ast.Binary):
+        age = _age_threshold(expr)
+        if age is not None:
+            return [age]
+    paths = [design_chain(spec, c, _seen) for c in ast.children(expr)]
+    return max(paths, key=sum, default=[])
 
 
+def _seconds_of(e: ast.Expr) -> float:
+    return float(e.value) if isinstance(e, ast.Lit) and isinstance(e.value, (int, float)) else 0.0
 
 
-def rule_time(spec: CheckedSpec, key: str, _seen: Optional[Set[str]] = None) -> float:
-    """The longest chain of `for`/`within` times through a rule and the rules it uses."""
-    seen = _seen or set()
-    if key in seen:
-        return 0.0
-    seen.add(key)
-    rule = spec.rule(key)
-    deps = [rule_time(spec, d, set(seen)) for d in rule.rule_deps]
-    return sum(design_times(rule.expr)) + max(deps, default=0.0)
-
-
-def behaviour_time(spec: CheckedSpec, b: Any) -> float:
-    """The same for a behaviour: its own times plus its slowest rule's."""
-    used = {e.key for e in ast.walk(b.cond) if isinstance(e, ast.RuleRef)}
-    return sum(design_times(b.cond)) + max((rule_time(spec, k) for k in used), default=0.0)
+def _age_threshold(e: ast.Binary) -> Optional[float]:
+    """T of `age(topic X) > T` (or `T < age(…)`): silence is seen T after the last message."""
+    if e.op in (">", ">=") and isinstance(e.left, ast.Age) and isinstance(e.right, ast.Lit):
+        return _seconds_of(e.right)
+    if e.op in ("<", "<=") and isinstance(e.right, ast.Age) and isinstance(e.left, ast.Lit):
+        return _seconds_of(e.left)
+    return None
 
 
 def hazards_via_rules(spec: CheckedSpec, b: Any) -> List[str]:

@@ -7,8 +7,8 @@ import platform
 from html import escape
 from typing import Any, Iterable, List, Sequence
 
-from .evidence import (Evidence, attrs, behaviour_label, behaviour_time, design_times, hazards_via_rules, rule_ids_of,
-                       rule_time, spec_text)
+from ..lang import ast
+from .evidence import (Evidence, attrs, behaviour_label, design_chain, hazards_via_rules, rule_ids_of, spec_text)
 from .timeline import svg
 
 CSS = """
@@ -115,7 +115,8 @@ def _reaction_note(ev: Evidence) -> str:
     if ev.reaction is None:
         return "<p>No benchmark figures were found, so the monitor's own reaction is not stated.</p>"
     r = ev.reaction
-    return (f"<p>Every rule's reaction by design is its own times (<code>for</code>, <code>within</code>). The monitor "
+    return (f"<p>Every rule's reaction by design is the time on its slowest path (<code>for</code>, <code>age(…) &gt; T</code>, "
+            f"through the rules it uses; see Behaviours). The monitor "
             f"adds its own reaction, measured on this machine from the violating message to the stop received by "
             f"the base: p50 {r.p50_ms:g} ms, p99 {r.p99_ms:g} ms, <b>worst {r.worst_ms:g} ms</b> over {r.cases} "
             f"cases (source: {_e(r.source)}).</p>")
@@ -125,10 +126,8 @@ def _rules(ev: Evidence) -> str:
     rows = []
     worst = ev.reaction.worst_ms if ev.reaction else None
     for r in ev.spec.rules:
-        times = design_times(r.expr)
-        total = rule_time(ev.spec, r.key)
-        if total != sum(times):
-            times = [total]  # through the rules it uses
+        times = design_chain(ev.spec, ast.RuleRef(r.key))  # through the rules it uses
+        total = sum(times)
         bound = f"{_seconds(times)}" + (f" + ≤ {worst:g} ms = ≤ {total + worst / 1000:.4g} s" if worst is not None else "")
         rows.append(f"<tr><td><code>{_e(r.key)}</code></td><td>{_rule_id(ev, r)}</td><td>{_attr(r, 'hazard')}</td>"
                     f"<td>{_attr(r, 'title')}</td><td>{_attr(r, 'ref')}</td><td>{bound}</td>"
@@ -145,15 +144,16 @@ def _behaviours(ev: Evidence) -> str:
         via = [h for h in hazards_via_rules(ev.spec, b) if h not in hazards]
         hz = _list(hazards) if hazards else ""
         hz += (" " if hz else "") + (f"<span class='muted'>via rules: {_list(via)}</span>" if via else "")
-        total = behaviour_time(ev.spec, b)
-        bound = f"{total:g} s" + (f" + ≤ {worst:g} ms" if worst is not None else "")
+        times = design_chain(ev.spec, b.cond, frozenset({b.index}))
+        bound = _seconds(times) + (f" + ≤ {worst:g} ms" if worst is not None else "")
         rows.append(f"<tr><td>{b.index}</td><td><b>{_e(behaviour_label(ev.spec, b.index))}</b></td>"
                     f"<td>{_attr(b, 'id')}</td><td>{hz or _list([])}</td><td>{_attr(b, 'title')}</td>"
                     f"<td>{_list(a.name for a in b.actions)}</td><td>{bound}</td>"
                     f"<td><pre>{_e(spec_text(ev.spec, b.span))}</pre></td></tr>")
-    return ("<h2 id='behaviours'>Behaviours</h2><p>A behaviour's time is the longest chain of <code>for</code> and "
-            "<code>within</code> times from its inputs through its rules to its condition, plus the monitor's measured "
-            "worst case.</p>" + _table(["#", "name", "id", "hazard", "title", "actions", "reaction (design + measured)",
+    return ("<h2 id='behaviours'>Behaviours</h2><p>A behaviour's time is its slowest path from its inputs through its "
+            "rules to its condition: each <code>for</code> on it adds its time, an <code>age(…) &gt; T</code> adds T, "
+            "<code>active(A)</code> the time of the slowest behaviour that starts A; <code>within</code> and "
+            "<code>latch</code> add nothing (true at once); then the monitor's measured worst case.</p>" + _table(["#", "name", "id", "hazard", "title", "actions", "reaction (design + measured)",
                                         "text"], rows))
 
 
