@@ -30,6 +30,18 @@ class Seat:
         """The action started: it owns the topic if nothing active outranks it."""
         self.arbiter._set(self, True)
 
+    def claim(self) -> None:
+        """The action is about to start (called on the dispatching thread for every start of an
+        instant before any runner is woken): it outranks lower actions at once, so none of them
+        publishes first. Without the topic's lock, which a runner holds while its publication
+        blocks (a stuck subscriber) and the engine's thread must never wait for; start() then
+        activates it again under the lock."""
+        self.active = True
+
+    def unclaim(self) -> None:
+        """A claimed start was dropped before it ran (its release came in the same queue)."""
+        self.active = False
+
     def deactivate(self) -> None:
         """The action was released: if it owned the topic, the next active action takes it."""
         self.arbiter._set(self, False)

@@ -69,6 +69,14 @@ class ActionPlugin:
     def setup(self) -> None:
         """Open publishers, ports, proxies; ActionSetupError for a configuration that cannot work."""
 
+    def claim(self) -> None:
+        """A start of this action is about to be submitted: called on the engine's thread for every
+        start of one instant before any runner runs; must not block. A plugin that shares a topic by
+        priority takes its seat here."""
+
+    def unclaim(self) -> None:
+        """A claimed start was dropped unrun (its release followed it in a full queue)."""
+
     def start(self, ctx: Context) -> None:
         """The behaviour turned true."""
 

@@ -40,6 +40,12 @@ class Dispatcher:
 
     def handle(self, engine: Engine, events: List[Event], cause: Any) -> None:
         spec = engine.spec
+        for e in events:  # first claim every start's actions: of actions that start in one instant on
+            if e.kind == "start":  # one topic, the highest priority owns it before any runner publishes
+                for bound in spec.behaviours[e.behaviour - 1].actions:
+                    runner = self.runners.get(bound.name)
+                    if runner is not None:
+                        runner.claim()
         for e in events:
             if e.kind not in ("start", "hold", "release"):
                 continue

@@ -79,6 +79,14 @@ class ActionRunner:
                 self._compact()
             self._cond.notify()
 
+    def claim(self) -> None:
+        """Before a start is submitted (the dispatcher claims every start of an instant first, so a
+        higher-priority action that starts with a lower one owns the topic before either publishes)."""
+        try:
+            self.plugin.claim()
+        except Exception as exc:  # noqa: BLE001 - a plugin's failure must never reach the engine
+            self.log("error", f"action '{self.plugin.name}' claim failed: {exc.__class__.__name__}: {exc}")
+
     def adopt(self, old: "ActionRunner") -> None:
         """Take over what the runner this one replaces (same action name, a reload changed its
         definition) holds: its holders stay holders and the action starts at once here, so a
@@ -114,6 +122,8 @@ class ActionRunner:
         else:
             items.pop(0)
         self._queue = collections.deque(items)
+        if not self._active and not any(kind == "release" for kind, _ in items):
+            self.plugin.unclaim()  # the start it claimed for never runs, nor does a release
 
     def wake(self) -> None:
         """Run the plugin's periodic work now, and its period from now on (any thread)."""

@@ -107,3 +107,93 @@ def test_clamp_twist_touches_only_named_axes():
     assert (twist.linear.x, twist.linear.y, twist.linear.z) == (0.2, 2.0, 3.0)
     assert (twist.angular.x, twist.angular.y, twist.angular.z) == (4.0, 5.0, -0.5)
     assert not math.isnan(twist.linear.x)
+
+
+def test_actions_that_start_in_one_instant_let_the_highest_priority_publish_first(tmp_path):
+    """Acceptance finding: `then { crawl; back_away; stop; }` on one topic: crawl's runner took the
+    topic and published before stop's runner had activated its seat (3 starts in 4, within 1 ms).
+    The dispatcher now claims every start of the instant before it wakes any runner."""
+    import time as _time
+
+    from rubass.actions.base import ActionPlugin
+    from rubass.actions.dispatch import Dispatcher
+    from rubass.actions.runner import ActionRunner
+    from rubass.engine import Event
+    from rubass.lang import check_text
+    from rubass.lang.library import ActionDef
+
+    arb, published = Arbiter(), []
+
+    class Seated(ActionPlugin):
+        def __init__(self, name, priority, delay):
+            super().__init__(ActionDef(name, "fake", {}, priority=priority))
+            self.seat, self.delay = arb.seat("/cmd", name, priority), delay
+
+        def claim(self):
+            self.seat.claim()
+
+        def start(self, ctx):
+            _time.sleep(self.delay)  # stop's runner is the slow one to wake
+            self.seat.activate()
+            with self.seat.turn() as mine:
+                if mine:
+                    published.append(self.name)
+
+    lib = tmp_path / "lib.yaml"
+    lib.write_text("actions:\n  crawl: {plugin: log}\n  stop: {plugin: log}\n")
+    spec = check_text("action primitive crawl, stop;\nentity e { rules: r: topic /x.data > 1; }\n"
+                      "if (e.r) then { crawl; stop; }\n", extra_libraries=[str(lib)])
+    plugins = {"crawl": Seated("crawl", 1, 0.0), "stop": Seated("stop", 2, 0.2)}
+    runners = {name: ActionRunner(p, lambda level, text: None) for name, p in plugins.items()}
+    for r in runners.values():
+        r.start_thread()
+    try:
+        engine = SimpleNamespace(spec=spec, behaviour_rules=lambda index: [])
+        Dispatcher(runners, lambda record: None, lambda: 0.0).handle(engine, [Event(0.0, "start", 1)], "test")
+        end = _time.monotonic() + 3
+        while "stop" not in published and _time.monotonic() < end:
+            _time.sleep(0.01)
+        assert published == ["stop"]  # crawl never owned the topic
+    finally:
+        for r in runners.values():
+            r.stop()
+
+
+def test_a_claimed_start_dropped_unrun_from_a_full_queue_gives_the_topic_back():
+    """The runner's queue drops a start whose release follows it (the pair is moot): the seat the
+    dispatcher claimed for that start must not stay active, or it would silence lower actions."""
+    from rubass.actions.base import ActionPlugin, Context
+    from rubass.actions.runner import MAX_PENDING, ActionRunner
+    from rubass.lang.library import ActionDef
+
+    arb = Arbiter()
+
+    class Seated(ActionPlugin):
+        def __init__(self):
+            super().__init__(ActionDef("stop", "fake", {}, priority=2))
+            self.seat = arb.seat("/cmd", "stop", 2)
+
+        def claim(self):
+            self.seat.claim()
+
+        def unclaim(self):
+            self.seat.unclaim()
+
+    plugin = Seated()
+    runner = ActionRunner(plugin, lambda level, text: None)  # its thread is not started: the queue fills
+    for i in range(MAX_PENDING):
+        runner.submit("hold", Context(1, 3)) if i % 2 else None
+    runner.claim()
+    runner.submit("start", Context(1, 3))
+    assert arb.owner("/cmd") is plugin.seat
+    runner.submit("release", Context(1, 3))
+    for _ in range(MAX_PENDING):
+        runner.claim()
+        runner.submit("start", Context(2, 3))
+        runner.submit("release", Context(2, 3))
+    assert not runner._active
+    # some pair was dropped, and a release for the others is still queued: the seat is free once they ran
+    kinds = [k for k, _ in runner._queue]
+    assert kinds.count("start") < MAX_PENDING + 1
+    if "release" not in kinds:
+        assert arb.owner("/cmd") is None
