@@ -6,11 +6,12 @@ progress, prints and saves the table of the finished runs marked as interrupted,
 from __future__ import annotations
 
 import argparse
+import io
 import json
 import os
 import sys
 from dataclasses import asdict
-from typing import TYPE_CHECKING, Any, Dict, List
+from typing import TYPE_CHECKING, Any, Dict, List, TextIO
 
 from .rows import ROWS, Row, row
 from .procs import Interrupted, Supervisor
@@ -63,24 +64,39 @@ def _run(rows: List[Row], reps: int, out: str, sup: Supervisor) -> int:
     data = results_json(rows, outcome.results)
     if outcome.signal is not None:
         data = _mark_interrupted(data, outcome, reps)
-    ok = print_table(data, sys.stdout)
-    with open(os.path.join(out, "table.json"), "w") as fh:
-        json.dump(data, fh, indent=1)
-    sys.stdout.flush()
+    table = io.StringIO()
+    ok = print_table(data, table)
+    with open(os.path.join(out, "table.json"), "w") as fh:  # saved before anything is printed: a
+        json.dump(data, fh, indent=1)  # Ctrl-C on `demo.sh | tee` also ends tee, so printing can fail
+    _say(sys.stdout, table.getvalue())
     png = os.path.join(out, "table.png")
     if outcome.signal is None:
         plot(data, png)
     bags = f"{os.path.join(out, 'runs')}/ROW/N/run.bag (rubass replay SPEC BAG)"
-    print(f"\ntable: {os.path.join(out, 'table.json')}\nplot:  {png if outcome.signal is None else '(not drawn: interrupted)'}"
-          f"\nbags:  {bags}")
+    _say(sys.stdout, f"\ntable: {os.path.join(out, 'table.json')}\nplot:  "
+                     f"{png if outcome.signal is None else '(not drawn: interrupted)'}\nbags:  {bags}\n")
     if outcome.signal is not None:
         exc = Interrupted(outcome.signal)
-        print(f"rubass experiments: interrupted by {exc.name}: {len(outcome.results)} of {len(rows) * reps} runs "
-              f"finished; every process it started is stopped", file=sys.stderr)
+        _say(sys.stderr, f"rubass experiments: interrupted by {exc.name}: {len(outcome.results)} of "
+                         f"{len(rows) * reps} runs finished; every process it started is stopped\n")
         return exc.exit_status
     if not ok:
-        print("rubass experiments: some row did not stop every time or missed the (b) target", file=sys.stderr)
+        _say(sys.stderr, "rubass experiments: some row did not stop every time or missed the (b) target\n")
     return 0 if ok else 1
+
+
+def _say(stream: TextIO, text: str) -> None:
+    """Write and flush; a reader that is gone (EPIPE) silences the stream, the run's status stands."""
+    try:
+        stream.write(text)
+        stream.flush()
+    except (BrokenPipeError, ValueError):  # ValueError: already closed
+        try:
+            devnull = os.open(os.devnull, os.O_WRONLY)
+            os.dup2(devnull, stream.fileno())  # the interpreter's flush at exit must not fail either
+            os.close(devnull)
+        except (OSError, ValueError):
+            pass
 
 
 def _mark_interrupted(data: Dict[str, Any], outcome: "Outcome", reps: int) -> Dict[str, Any]:
