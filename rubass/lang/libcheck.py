@@ -3,12 +3,12 @@ service type exists, and every field of `message:`, `on_release:` and `request:`
 value of a fitting type. Errors point at the YAML file and line."""
 from __future__ import annotations
 
-from typing import Any, Dict, List, Optional, Tuple
+from typing import Any, Dict, Iterable, List, Optional, Tuple
 
 import yaml
 
 from .errors import Diagnostic, did_you_mean
-from .library import ActionDef
+from .library import TWIST_TYPES, ActionDef
 from .msgdef import INTEGERS, FieldDef, MsgSpec, Registry
 from .source import SourceSet, Span
 from .yamltags import plain_value
@@ -137,11 +137,13 @@ def _primitive_problem(ftype: str, v: Any) -> Optional[str]:
 
 
 def check_library_types(actions: Dict[str, ActionDef], sources: SourceSet, registry: Registry,
-                        looked_in: str = "installed packages") -> List[Diagnostic]:
+                        looked_in: str = "installed packages", known: Iterable[str] = ()) -> List[Diagnostic]:
     """Errors for publish and service actions whose types or fields do not fit the definitions.
 
-    `looked_in` says where types were looked for, for the message of an unknown type."""
+    `looked_in` says where types were looked for, for the message of an unknown type; `known`
+    are more type names to suggest from (those installed in its package)."""
     diags: List[Diagnostic] = []
+    known = list(known)
     for act in sorted(actions.values(), key=lambda a: (a.span.file, a.span.line)):
         if act.plugin not in ("publish", "service"):
             continue
@@ -154,7 +156,7 @@ def check_library_types(actions: Dict[str, ActionDef], sources: SourceSet, regis
             spec = registry.get(type_name)
             if spec is None:
                 diags.append(Diagnostic(type_span, f"action '{act.name}': unknown message type '{type_name}' "
-                                                   f"(not in {looked_in}){did_you_mean(type_name, registry.types)}"))
+                                                   f"(not in {looked_in}){did_you_mean(type_name, list(registry.types) + known)}"))
                 continue
             for key in ("message", "on_release"):
                 if key in nodes:
@@ -163,7 +165,7 @@ def check_library_types(actions: Dict[str, ActionDef], sources: SourceSet, regis
             srv = registry.services.get(type_name)
             if srv is None:
                 diags.append(Diagnostic(type_span, f"action '{act.name}': unknown service type '{type_name}' "
-                                                   f"(not in {looked_in}){did_you_mean(type_name, registry.services)}"))
+                                                   f"(not in {looked_in}){did_you_mean(type_name, list(registry.services) + known)}"))
                 continue
             if "request" in nodes:
                 c.message(srv[0], nodes["request"][1], "request")
@@ -180,20 +182,34 @@ def library_types(actions: Dict[str, ActionDef]) -> Tuple[List[str], List[str]]:
 
 def check_publish_topics(actions: Dict[str, ActionDef], sources: SourceSet, topics: Dict[str, str],
                          source: str) -> List[Diagnostic]:
-    """Errors for publish actions whose topic carries another type in the system model: the
-    robot's subscribers would refuse the connection and the message would never arrive."""
+    """Errors for actions whose topics carry another type in the system model: a publish
+    action's or a limit's output (the robot's subscribers would refuse the connection and the
+    message would never arrive), and a limit's input (it would refuse every command)."""
     diags: List[Diagnostic] = []
     for act in sorted(actions.values(), key=lambda a: (a.span.file, a.span.line)):
-        if act.plugin != "publish":
+        if act.plugin not in ("publish", "limit"):
             continue
-        if str(act.params.get("topic", "")).startswith("~"):
-            continue  # private to the monitor: resolved under its own name
-        topic = "/" + str(act.params.get("topic", "")).strip("/")
-        have, want = topics.get(topic), str(act.params.get("type"))
-        if have is None or have == want:
-            continue
-        node = _action_nodes(sources, act).get("type", (None, None))[1]
-        span = _span(node, act.span.file) if node is not None else act.span
-        diags.append(Diagnostic(span, f"action '{act.name}': publishes {want} on {topic}, which carries {have} in "
-                                      f"{source}: its subscribers would refuse the connection"))
+        want = str(act.params.get("type"))
+        for key in ("input", "topic") if act.plugin == "limit" else ("topic",):
+            name = str(act.params.get(key, ""))
+            if name.startswith("~"):
+                continue  # private to the monitor: resolved under its own name
+            topic = "/" + name.strip("/")
+            have = topics.get(topic)
+            if have is None or have == want:
+                continue
+            if act.plugin == "publish":
+                node = _action_nodes(sources, act).get("type", (None, None))[1]
+                span = _span(node, act.span.file) if node is not None else act.span
+                text = f"publishes {want} on {topic}, which carries {have} in {source}: its subscribers would " \
+                       f"refuse the connection"
+            else:
+                span = act.key_spans.get(key, act.span)
+                said = "as its 'type' says" if "type" in act.key_spans else "its default type"
+                text = (f"its {key} {topic} carries {have} in {source}, but the limit "
+                        f"{'reads' if key == 'input' else 'publishes'} {want} ({said}): "
+                        + ("it would refuse every command" if key == "input" else
+                           "the robot's subscribers would refuse the connection")
+                        + (f"; set 'type: {have}'" if have in TWIST_TYPES else ""))
+            diags.append(Diagnostic(span, f"action '{act.name}': {text}"))
     return diags

@@ -11,9 +11,12 @@ import yaml
 
 from .errors import Diagnostic, a_noun, did_you_mean
 from .grammar import KEYWORDS
+from .libtopics import topic_conflicts
 from .source import Source, SourceSet, Span
+from .stdlib import is_standard_library
+from .topicnames import resolve as resolve_topic
 from .units import FREQUENCY, SPEED, TIME, Dimension, dim, dimension_name, parse_quantity
-from .yamltags import foreign_tags, plain_value, resolve_merges
+from .yamltags import duplicate_keys, foreign_tags, plain_value, resolve_merges
 
 BUILTIN_PLUGINS = ("publish", "serial", "service", "log", "limit")
 CUSTOM_PLUGIN_RE = re.compile(r"[A-Za-z_][A-Za-z0-9_]*(?:\.[A-Za-z_][A-Za-z0-9_]*)*:[A-Za-z_][A-Za-z0-9_]*")
@@ -41,6 +44,7 @@ class ActionDef:
     span: Span = field(default=Span("<none>", 0, 0), compare=False)
     priority: int = 0  # among actions publishing on the same topic, the highest publishes (§16)
     plugin_span: Span = field(default=Span("<none>", 0, 0), compare=False)  # its `plugin:` value
+    key_spans: Dict[str, Span] = field(default_factory=dict, compare=False)  # where each key's value is
 
     @property
     def is_custom(self) -> bool:
@@ -223,14 +227,12 @@ _LOADED: "weakref.WeakKeyDictionary[SourceSet, List[ActionDef]]" = weakref.WeakK
 
 
 def _clashes(earlier: List[ActionDef], actions: Dict[str, ActionDef]) -> List[Diagnostic]:
-    """Priority conflicts of a library's actions with those of libraries loaded before it
-    (an action of the same name is another error, which the checker reports)."""
+    """Topic conflicts (type, priority) of a library's actions with those of libraries loaded
+    before it (an action of the same name is another error, which the checker reports)."""
     out = []
     for a in actions.values():
-        for d in priority_conflicts([e for e in earlier if e.name != a.name and e.span.file != a.span.file] + [a]):
-            if d.span == a.span:
-                out.append(dataclasses.replace(d, subject=a.name))
-                break
+        others = [e for e in earlier if e.name != a.name and e.span.file != a.span.file]
+        out += [d for d in topic_conflicts(others + [a]) if d.subject == a.name][:1]
     return out
 
 
@@ -254,6 +256,7 @@ def parse_library(src: Source) -> Tuple[Dict[str, ActionDef], List[Diagnostic]]:
         return {}, [Diagnostic(_Node(n, src.name).span, f"YAML tag '{n.tag}' is not allowed: an action library "
                                                         f"holds plain data only (strings, numbers, booleans, "
                                                         f"lists, mappings)") for n in foreign]
+    dups = duplicate_keys(root)  # before merging: a merged key is no duplicate
     try:
         bad_merges = resolve_merges(root)  # `<<: *base` shares keys between actions
     except RecursionError:
@@ -272,6 +275,7 @@ def parse_library(src: Source) -> Tuple[Dict[str, ActionDef], List[Diagnostic]]:
     if not isinstance(actions_node, yaml.MappingNode):
         return {}, diags + [Diagnostic(_Node(actions_node, src.name).span,
                                        "'actions' must be a mapping from action names to definitions")]
+    broken = _duplicates(dups, actions_node, src.name, diags)
     out: Dict[str, ActionDef] = {}
     for knode, vnode in actions_node.value:
         name, kspan = _key(knode), _Node(knode, src.name).span
@@ -283,14 +287,33 @@ def parse_library(src: Source) -> Tuple[Dict[str, ActionDef], List[Diagnostic]]:
             continue
         action, problems = _action(name, kspan, _Node(vnode, src.name), src.name)
         diags.extend(dataclasses.replace(d, subject=name) for d in problems)
-        if action is not None:
+        if action is not None and id(vnode) not in broken:
             out[name] = action
-    conflicts = []
-    for d in priority_conflicts(out.values()):
-        names = [k for k, v in out.items() if v.span == d.span]
-        conflicts.append(dataclasses.replace(d, subject=names[0] if names else ""))
-        out = {k: v for k, v in out.items() if v.span != d.span}
-    return out, diags + conflicts
+    conflicts = priority_conflicts(out.values())
+    bad = {d.subject for d in conflicts}
+    return {k: v for k, v in out.items() if k not in bad}, diags + conflicts
+
+
+def _duplicates(dups: List[Tuple[yaml.Node, yaml.Node, yaml.Node]], actions_node: yaml.MappingNode, file: str,
+                diags: List[Diagnostic]) -> set:
+    """An error at each key written twice in one mapping (YAML would keep the last silently);
+    the ids of the action definitions that hold one, which are left out. Action names written
+    twice are reported by the caller."""
+    broken = set()
+    for mapping, second, first in dups:
+        if mapping is actions_node:
+            continue
+        owner = next(((k, v) for k, v in actions_node.value
+                      if v.start_mark.index <= second.start_mark.index < v.end_mark.index), None)
+        name = _key(owner[0]) if owner else ""
+        where = f"action '{name}': " if owner else ""
+        if owner:
+            broken.add(id(owner[1]))
+        diags.append(Diagnostic(_Node(second, file).span, f"{where}key '{_key(second)}' is written twice in one "
+                                                          f"mapping (first at {first.start_mark.line + 1}:{first.start_mark.column + 1}); "
+                                                          f"YAML would keep only the last: remove one",
+                                subject=name))
+    return broken
 
 
 def _key(node: yaml.Node) -> str:
@@ -311,6 +334,11 @@ def _action(name: str, span: Span, node: _Node, file: str) -> Tuple[Optional[Act
         hint = did_you_mean(str(plugin), BUILTIN_PLUGINS)
         return None, [Diagnostic(pnode.span, f"{where}: unknown plugin {plugin!r} (built-ins: "
                                              f"{', '.join(BUILTIN_PLUGINS)}; custom: 'package.module:Class'){hint}")]
+    if ":" in plugin and is_standard_library(plugin.partition(":")[0]):
+        # as the monitor refuses it (actions/base.py), before anything is imported
+        return None, [Diagnostic(pnode.span, f"{where}: plugin module '{plugin.partition(':')[0]}' is part of "
+                                             f"Python's standard library; a custom plugin must be a class in the "
+                                             f"robot's own package")]
     diags: List[Diagnostic] = []
     params: Dict[str, Any] = {}
     schema = SCHEMAS.get(plugin, {})
@@ -345,7 +373,8 @@ def _action(name: str, span: Span, node: _Node, file: str) -> Tuple[Optional[Act
         return None, diags
     latch = bool(params.pop("latch", False))
     priority = int(params.pop("priority", 0))
-    return ActionDef(name, plugin, params, latch, span, priority, pnode.span), []
+    spans = {k: vnode.span for k, (_, vnode) in fields.items()}
+    return ActionDef(name, plugin, params, latch, span, priority, pnode.span, spans), []
 
 
 def _limit_problems(where: str, span: Span, params: Dict[str, Any], fields: Dict[str, Any]) -> List[Diagnostic]:
@@ -359,19 +388,8 @@ def _limit_problems(where: str, span: Span, params: Dict[str, Any], fields: Dict
     return out
 
 
-def priority_conflicts(actions: Iterable[ActionDef], resolve: Callable[[str], str] = lambda t: t) -> List[Diagnostic]:
-    """Two actions with the same priority publishing on the same topic (§16): one error each
-    after the first, at its definition. `resolve` maps topic names (the monitor resolves them)."""
-    seen: Dict[Tuple[str, int], ActionDef] = {}
-    out: List[Diagnostic] = []
-    for a in sorted(actions, key=lambda a: (a.span.file, a.span.line, a.span.col, a.name)):
-        if a.plugin not in TOPIC_PLUGINS:
-            continue
-        topic = resolve(a.params["topic"])
-        first = seen.setdefault((topic, a.priority), a)
-        if first is not a:
-            place = f"line {first.span.line}" if first.span.file == a.span.file else str(first.span)
-            out.append(Diagnostic(a.span, f"action '{a.name}': same priority ({a.priority}) as action "
-                                          f"'{first.name}' ({place}), and both publish on {topic}; which one "
-                                          f"publishes must not be left to chance: give one a higher 'priority'"))
-    return out
+def priority_conflicts(actions: Iterable[ActionDef], resolve: Callable[[str], str] = resolve_topic) -> List[Diagnostic]:
+    """Actions on one topic (§16) with different message types or the same priority: one error
+    each after the first in file order, at its place (libtopics.topic_conflicts). `resolve` maps
+    topic names (the monitor resolves them as its node; by default as a node at the root)."""
+    return topic_conflicts(sorted(actions, key=lambda a: (a.span.file, a.span.line, a.span.col, a.name)), resolve)

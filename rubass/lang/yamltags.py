@@ -2,7 +2,7 @@
 custom '!tags'), so that a file is reported as an error rather than a loader traceback."""
 from __future__ import annotations
 
-from typing import AbstractSet, Any, List, Set
+from typing import AbstractSet, Any, Dict, List, Set, Tuple
 
 import yaml
 
@@ -92,3 +92,30 @@ def _merge(node: yaml.MappingNode, done: Set[int], bad: List[yaml.Node]) -> None
             seen.add(name)
             own.append((key, value))
     node.value = own
+
+
+def duplicate_keys(root: yaml.Node) -> List[Tuple[yaml.Node, yaml.Node, yaml.Node]]:
+    """(mapping, second key, first key) for each scalar key written again in one mapping, in
+    file order (YAML loaders keep the last silently). Merge keys ('<<') are not counted: call
+    this before resolve_merges. Each mapping is looked at once (alias bombs are DAGs)."""
+    out: List[Tuple[yaml.Node, yaml.Node, yaml.Node]] = []
+    todo, visited = [root], set()
+    while todo:
+        node = todo.pop()
+        if id(node) in visited:
+            continue
+        visited.add(id(node))
+        if isinstance(node, yaml.MappingNode):
+            first: Dict[Any, yaml.Node] = {}
+            for key, _ in node.value:
+                if not isinstance(key, yaml.ScalarNode) or key.tag == MERGE:
+                    continue
+                ident = (key.tag, key.value)
+                if ident in first:
+                    out.append((node, key, first[ident]))
+                else:
+                    first[ident] = key
+            todo += [n for pair in node.value for n in pair]
+        elif isinstance(node, yaml.SequenceNode):
+            todo += list(node.value)
+    return sorted(out, key=lambda t: t[1].start_mark.index)

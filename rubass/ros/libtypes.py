@@ -3,6 +3,7 @@ system after its own: action libraries against definitions, topics and nodes a m
 Light: the monitor runs these at start and at every reload."""
 from __future__ import annotations
 
+import importlib
 import os
 from typing import Dict, Iterable, List, Optional, Sequence, Tuple
 
@@ -16,7 +17,14 @@ from ..lang.sourcefile import read_source
 from ..lang.libcheck import check_library_types, check_publish_topics, library_types
 from ..lang.model import CheckedSpec
 from ..lang.msgdef import Registry, parse_full
+from ..lang.stdlib import is_standard_library
 from ..lang.sysmodel import SystemModel, graph_warnings
+
+
+def _importable(type_name: str) -> bool:
+    """Whether looking the type up may import its package: never a standard library module
+    (importing 'antigravity' opens a browser, and a library is not to run code)."""
+    return not is_standard_library(type_name.split("/")[0])
 
 
 def add_installed(registry: Registry, msg_types: Iterable[str], srv_types: Iterable[str] = ()) -> None:
@@ -24,7 +32,7 @@ def add_installed(registry: Registry, msg_types: Iterable[str], srv_types: Itera
     import roslib.message
 
     for t in msg_types:
-        if registry.get(t) is not None:
+        if registry.get(t) is not None or not _importable(t):
             continue
         try:
             cls = roslib.message.get_message_class(t)
@@ -33,7 +41,7 @@ def add_installed(registry: Registry, msg_types: Iterable[str], srv_types: Itera
         except Exception:  # not installed, a broken package, a bad name: unknown here
             continue
     for t in srv_types:
-        if t in registry.services:
+        if t in registry.services or not _importable(t):
             continue
         try:
             cls = roslib.message.get_service_class(t)
@@ -46,6 +54,27 @@ def add_installed(registry: Registry, msg_types: Iterable[str], srv_types: Itera
         for spec in list(req.values()) + list(resp.values()):
             registry.add(spec)
         registry.add_service(t, req[t + "Request"], resp[t + "Response"])
+
+
+def installed_names(registry: Registry, msgs: Iterable[str], srvs: Iterable[str]) -> List[str]:
+    """The installed message and service types of the packages of those not found, for a
+    did-you-mean ('std_srvs/Trigerr': 'std_srvs/Trigger', not another type the library names)."""
+    out: List[str] = []
+    wanted = {(t.split("/")[0], "msg") for t in msgs if registry.get(t) is None} | \
+             {(t.split("/")[0], "srv") for t in srvs if t not in registry.services}
+    for package, kind in sorted(wanted):
+        if not package.isidentifier() or not _importable(package + "/"):
+            continue
+        try:
+            module = importlib.import_module(f"{package}.{kind}")
+        except Exception:  # no such package here, or a broken one: nothing to suggest
+            continue
+        for name in dir(module):
+            cls = getattr(module, name, None)
+            type_name = getattr(cls, "_type", None)
+            if isinstance(type_name, str) and (kind == "msg") != hasattr(cls, "_request_class"):
+                out.append(type_name)
+    return out
 
 
 def try_installed(registry: Registry, msgs: Iterable[str], srvs: Iterable[str]) -> bool:
@@ -76,7 +105,8 @@ def library_errors(actions: Dict[str, ActionDef], sources: SourceSet, model: Opt
         return []  # nothing to check against
     where = " or ".join(([model.source] if model is not None else []) +
                         (["the message packages installed here"] if installed else []))
-    errors = check_library_types(actions, sources, registry, where)
+    known = installed_names(registry, msgs, srvs) if installed else []
+    errors = check_library_types(actions, sources, registry, where, known)
     if model is not None:
         errors += check_publish_topics(actions, sources, model.topics, model.source)
     return errors
@@ -86,7 +116,7 @@ def after_failed_check(path: str, extra: Sequence[str],
                        model: Optional[SystemModel]) -> Tuple[List[Diagnostic], List[Diagnostic], SourceSet]:
     """after_check for a spec that did not check, so that everything is reported in one run:
     (library errors, topic and node warnings, their sources); nothing when the spec cannot be
-    parsed, and no library errors when a library has errors of its own (already reported)."""
+    parsed. A library with errors of its own (reported already) has its valid actions checked."""
     sources = SourceSet()
     src, _ = read_source(path)
     if src is None:
@@ -103,8 +133,6 @@ def after_failed_check(path: str, extra: Sequence[str],
     for f in files:
         if not os.path.isfile(f):
             continue
-        lib, diags = load_library(f, sources)
-        if diags:
-            return [], warnings, sources
+        lib, _ = load_library(f, sources)  # its own errors are reported already; check its valid actions
         actions.update(lib)
     return library_errors(actions, sources, model), warnings, sources
