@@ -164,8 +164,9 @@ class Engine:
         self._readers = readers
         for topic in spec.topics:
             self.store.watch(topic, now, windows.get(topic, 0.0))
-        self._paths = {t: tuple(sorted((p for p in u.paths if p != STAMP), key=str))  # rate fields too
-                       for t, u in spec.topics.items()}
+        explicit = spec.field_readers(implicit=False)  # header.stamp as a field, not only for stamp_age
+        self._paths = {t: tuple(sorted((p for p in u.paths if p != STAMP or STAMP in explicit.get(t, ())), key=str))
+                       for t, u in spec.topics.items()}  # rate fields too
         # per topic: (slot number, store slot, its cell, path, its key in field_errors), computed once
         self._reads = {t: tuple((self._slot_ids.setdefault((t, p), len(self._slot_ids)), (t, p),
                                  self.store.cell((t, p)), p, str(p)) for p in paths)
