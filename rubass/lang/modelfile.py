@@ -7,6 +7,7 @@ from typing import Any, Dict, List, Optional, Tuple
 import yaml
 
 from .errors import Diagnostic, did_you_mean
+from .modelcheck import definition_problems, duplicates, unit_path_problem, version_problem
 from .msgdef import TYPE_RE, DefinitionError, parse_msg
 from .source import Source, SourceSet, Span
 from .sysmodel import SystemModel
@@ -30,6 +31,7 @@ class _Reader:
     def __init__(self, file: str) -> None:
         self.file = file
         self.diags: List[Diagnostic] = []
+        self.unit_keys: List[Tuple[str, str, str, yaml.Node]] = []  # ('topic'/'type', its name, path, key)
 
     def error(self, node: yaml.Node, msg: str) -> None:
         self.diags.append(Diagnostic(_span(node, self.file), msg))
@@ -55,9 +57,10 @@ class _Reader:
             return None
         return text
 
-    def units(self, node: yaml.Node, what: str) -> Dict[str, Dimension]:
+    def units(self, node: yaml.Node, what: str, owner: Tuple[str, str] = ("", "")) -> Dict[str, Dimension]:
         out: Dict[str, Dimension] = {}
         for path, knode, vnode in self.mapping(node, what):
+            self.unit_keys.append((owner[0], owner[1], path, knode))
             unit = self.string(vnode, f"the unit of '{path}'")
             if unit is None:
                 continue
@@ -90,7 +93,13 @@ def parse_model(src: Source) -> Tuple[Optional[SystemModel], List[Diagnostic]]:
     if foreign:
         return None, [Diagnostic(_span(n, src.name), f"YAML tag '{n.tag}' is not allowed: a system model holds "
                                                      "plain data only") for n in foreign]
+    for key, why in duplicates(root):
+        r.error(key, why)
     entries = {k: (kn, v) for k, kn, v in r.mapping(root, "a system model")}
+    if "rubass_model" in entries:
+        problem = version_problem(_plain(entries["rubass_model"][1]))
+        if problem:
+            r.error(entries["rubass_model"][1], problem)
     for key, (knode, _) in entries.items():
         if key not in KEYS:
             r.error(knode, f"unknown key '{key}'{did_you_mean(key, KEYS)} (keys: {', '.join(KEYS)})")
@@ -112,7 +121,7 @@ def parse_model(src: Source) -> Tuple[Optional[SystemModel], List[Diagnostic]]:
                 continue
             ty = r.msg_type(fields["type"], f"the type of topic '{name}'")
             if "units" in fields:
-                topic_units[name] = r.units(fields["units"], f"the units of topic '{name}'")
+                topic_units[name] = r.units(fields["units"], f"the units of topic '{name}'", ("topic", name))
         else:
             ty = r.msg_type(vnode, f"the type of topic '{name}'")
         if ty is not None:
@@ -129,25 +138,37 @@ def parse_model(src: Source) -> Tuple[Optional[SystemModel], List[Diagnostic]]:
         if TYPE_RE.fullmatch(ty) is None:
             r.error(knode, f"'units' are given per message type 'package/Type', got {ty!r}")
             continue
-        units[ty] = r.units(vnode, f"the units of {ty}")
+        units[ty] = r.units(vnode, f"the units of {ty}", ("type", ty))
     model = SystemModel(topics, nodes, units=units, topic_units=topic_units,
                         source=f"the system model {src.name}")
-    for ty, knode, vnode in r.mapping(entries["definitions"][1], "'definitions'") if "definitions" in entries else []:
+    definitions = r.mapping(entries["definitions"][1], "'definitions'") if "definitions" in entries else []
+    for ty, knode, vnode in definitions:
         text = r.string(vnode, f"the definition of {ty}")
         if text is None:
             continue
+        problems = definition_problems(ty, text, [t for t, _, _ in definitions])
         try:
-            model.registry.add(parse_msg(ty, text))
+            spec = parse_msg(ty, text)
         except DefinitionError as exc:
-            place = _definition_line(src, vnode, exc.line)
+            problems = problems or [(exc.line, str(exc))]
+        for line, why in problems:
+            place = _definition_line(src, vnode, line)
             if place is None:
-                r.error(vnode, f"the definition of {ty}: {exc}")
+                r.error(vnode, f"the definition of {ty}: {why}")
             else:
-                r.diags.append(Diagnostic(place, f"the definition of {ty}: {exc}"))
+                r.diags.append(Diagnostic(place, f"the definition of {ty}: {why}"))
+        if not problems:
+            model.registry.add(spec)
+    for kind, owner, path, knode in r.unit_keys:  # fields a known definition lacks
+        root_type = topics.get(owner) if kind == "topic" else owner
+        problem = unit_path_problem(model.registry, root_type, path) if root_type else None
+        if problem:
+            r.error(knode, f"the units of {'topic ' + repr(owner) if kind == 'topic' else owner}: {problem}")
     if "source" in entries:
         text = r.string(entries["source"][1], "'source'")
         if text:
             model.source = f"the system model {src.name} (from {text})"
+    r.diags.sort(key=lambda d: (d.span.line, d.span.col))
     return (None, r.diags) if r.diags else (model, [])
 
 

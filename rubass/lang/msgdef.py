@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import re
 from dataclasses import dataclass
-from typing import Dict, Iterable, List, Optional, Tuple
+from typing import Dict, Iterable, Iterator, List, Optional, Tuple
 
 from .errors import RubassError
 
@@ -72,17 +72,23 @@ def _full_type(name: str, package: str) -> str:
     return f"{package}/{name}"
 
 
+def definition_lines(text: str) -> Iterator[Tuple[int, str, Optional["re.Match[str]"]]]:
+    """(1-based line number, the line, its match: type, [size], size, name, '= constant'; None
+    when it cannot be read) for each line of a definition that is not blank or a comment."""
+    for number, raw in enumerate(text.splitlines(), 1):
+        line = raw.split("#", 1)[0].strip() if "=" not in raw.split("#", 1)[0] else raw.strip()
+        if not line or line.startswith("#"):
+            continue
+        yield number, raw, _FIELD.match(line)
+
+
 def parse_msg(type_name: str, text: str) -> MsgSpec:
     """The fields of one message's own definition (no embedded dependencies)."""
     if not TYPE_RE.fullmatch(type_name):
         raise DefinitionError(f"'{type_name}' is not a message type name 'package/Type'")
     package = type_name.split("/")[0]
     fields: List[FieldDef] = []
-    for number, raw in enumerate(text.splitlines(), 1):
-        line = raw.split("#", 1)[0].strip() if "=" not in raw.split("#", 1)[0] else raw.strip()
-        if not line or line.startswith("#"):
-            continue
-        m = _FIELD.match(line)
+    for number, raw, m in definition_lines(text):
         if m is None:
             raise DefinitionError(f"{type_name}: line {number}: cannot read '{raw.strip()}'", number)
         ftype, arr, size, name, const = m.groups()

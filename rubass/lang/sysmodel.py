@@ -8,7 +8,7 @@ from typing import Dict, Iterator, List, Optional, Set, Tuple
 from . import ast
 from .errors import Diagnostic, did_you_mean
 from .fieldmodel import FieldInfo
-from .msgdef import Registry
+from .msgdef import FieldDef, Registry
 from .msgpath import UnitTable, has_stamp, resolve
 from .std_units import STANDARD_UNITS
 from .topicnames import resolve as resolve_topic
@@ -50,6 +50,9 @@ class SystemModel:
         type_name = self.topics.get(norm_topic(topic))
         if type_name is None:
             return None
+        beyond = _index_beyond(self.registry, type_name, path)
+        if beyond is not None:
+            return FieldInfo("missing", why=beyond)
         return resolve(self.registry, type_name, path, (STANDARD_UNITS, self.units),
                        self.topic_units.get(norm_topic(topic)))
 
@@ -77,6 +80,27 @@ class SystemModel:
             else:
                 todo += [f.type for f in spec.fields if not f.is_primitive]
         return sorted(missing)
+
+
+def _index_beyond(registry: Registry, root: str, path: Tuple[ast.PathElem, ...]) -> Optional[str]:
+    """Why an index of the path is outside a fixed-size array (`position_covariance[9]` of a
+    float64[9]); None when every index fits or a size is not known (other problems are resolve's)."""
+    current: Optional[FieldDef] = None
+    for i, elem in enumerate(path):
+        if isinstance(elem, str):
+            spec = registry.get(root if current is None else current.type)
+            current = spec.get(elem) if spec is not None else None
+            if current is None:
+                return None
+        elif isinstance(elem, int) and current is not None and current.is_array and current.length is not None:
+            if not -current.length <= elem < current.length:
+                where = ast.path_suffix(path[:i]).lstrip(".")
+                return (f"'{where}[{elem}]' is beyond the end of '{where}', a {current.type}[{current.length}]: "
+                        f"its indices are 0 to {current.length - 1}")
+            current = FieldDef(current.name, current.type)  # its element
+        else:
+            return None
+    return None
 
 
 def _topic_refs(spec: ast.Spec) -> Iterator[ast.TopicRef]:
