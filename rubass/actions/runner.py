@@ -1,5 +1,6 @@
 """One thread per action: phases run in order off the engine's thread, holds are coalesced,
-and a failing start or release is retried until it succeeds or is superseded.
+and a failing start or release is retried until it succeeds or is superseded; a plugin call that
+does not return is reported by a watchdog thread shared by every runner.
 
 submit() never blocks: the engine thread hands over and goes on evaluating.
 """
@@ -8,6 +9,7 @@ from __future__ import annotations
 import collections
 import threading
 import time
+import weakref
 from typing import Any, Callable, Deque, Dict, Optional, Set, Tuple
 
 from .base import ActionPlugin, ActionStats, Context
@@ -17,6 +19,8 @@ Log = Callable[[str, str], None]  # (level, text)
 BACKOFF = (0.05, 0.1, 0.2, 0.5, 1.0)
 MAX_PENDING = 1000  # phases waiting for a plugin that is slower than the condition flaps
 LOG_EVERY = 5.0  # seconds between two log lines about the same failing action
+STUCK_AFTER = 2.0  # a plugin call still running this long (beyond the plugin's own call_timeout) is stuck
+WATCH_EVERY = 0.25  # how often the watchdog looks at the calls in progress
 # the phases whose success resolves a failure of each phase; a plugin's bad input only by the plugin
 # (a good input: holds succeed at 50 Hz whatever the input); the runner's own by the next phase
 _RESOLVED_BY = {"start": ("start", "release"), "release": ("release", "start"),
@@ -37,6 +41,10 @@ class ActionRunner:
         self._next_periodic = float("inf")
         self._last_log = 0.0
         self._thread: Optional[threading.Thread] = None
+        self._call_lock = threading.Lock()  # the call in progress, shared with the watchdog's thread
+        self._call: Optional[Tuple[str, float]] = None  # (phase, monotonic start) of the plugin call running now
+        self._stuck = False  # the call in progress has been reported stuck
+        self._stuck_log = 0.0
         plugin.wake = self.wake  # type: ignore[method-assign]
         plugin.stats = self.stats  # a plugin may count failures of its own threads (limit: a bad input)
 
@@ -44,9 +52,40 @@ class ActionRunner:
     def active(self) -> bool:
         return bool(self._active)
 
+    @property
+    def stuck_after(self) -> float:
+        """Seconds a plugin call may run before it is reported stuck: STUCK_AFTER beyond the time the
+        plugin itself may block (its `call_timeout`: a service's timeout, a serial write timeout)."""
+        own = getattr(self.plugin, "call_timeout", 0.0)
+        return STUCK_AFTER + (float(own) if isinstance(own, (int, float)) and own > 0 else 0.0)
+
     def start_thread(self) -> None:
         self._thread = threading.Thread(target=self._run, name=f"rubass-action-{self.plugin.name}", daemon=True)
         self._thread.start()
+        _WATCHDOG.add(self)
+
+    def stuck(self, now: float) -> Optional[str]:
+        """Whether the plugin call in progress has run longer than `stuck_after` at `now` (monotonic);
+        if so it is counted once, logged (again every LOG_EVERY s) and makes the action failing until
+        it returns. Called from another thread than the (stuck) runner's: the watchdog's."""
+        with self._call_lock:
+            if self._call is None:
+                return None
+            what, since = self._call
+            if now - since < self.stuck_after:
+                return None
+            text = f"{what} has not returned for {now - since:.1f} s: the action is stuck"
+            first, self._stuck = not self._stuck, True
+            if first:
+                self.stats.failures += 1
+            self.stats.failing = what
+            self.stats.last_error = text
+            say = first or now - self._stuck_log >= LOG_EVERY
+            if say:
+                self._stuck_log = now
+        if say:
+            self.log("error", f"action '{self.plugin.name}' {text}")
+        return text
 
     # -- the engine's thread -------------------------------------------------------------
     def submit(self, kind: str, ctx: Context) -> None:
@@ -132,6 +171,7 @@ class ActionRunner:
             self._cond.notify()
 
     def stop(self, timeout: float = 2.0) -> None:
+        _WATCHDOG.discard(self)
         with self._cond:
             self._stop = True
             self._cond.notify()
@@ -207,9 +247,12 @@ class ActionRunner:
                 return  # at shutdown a release is tried a few times, not forever
 
     def _guard(self, what: str, fn: Callable[[], None]) -> bool:
+        with self._call_lock:
+            self._call = (what, time.monotonic())
         try:
             fn()
         except Exception as exc:  # a plugin's failure must never reach the engine
+            self._returned()
             self.stats.failures += 1
             self.stats.failing = what
             self.stats.last_error = f"{what}: {exc.__class__.__name__}: {exc}"
@@ -219,10 +262,18 @@ class ActionRunner:
                 self.log("error", f"action '{self.plugin.name}' {what} failed ({self.stats.failures} failures so "
                                   f"far; retrying): {exc.__class__.__name__}: {exc}")
             return False
+        self._returned()
         if what != "periodic":
             self.stats.calls += 1
         self._resolve(what)
         return True
+
+    def _returned(self) -> None:
+        """The plugin call returned: the watchdog no longer looks at it (a stuck phase that returned
+        successfully is then resolved by _resolve like any failure)."""
+        with self._call_lock:
+            self._call = None
+            self._stuck = False
 
     def _resolve(self, what: str) -> None:
         """A success after a failure: the error stays on record but no longer makes /diagnostics ERROR.
@@ -236,3 +287,38 @@ class ActionRunner:
         self.stats.last_error = RESOLVED + error
         if failed != "input":  # a plugin's own bad-input count is logged by the plugin
             self.log("info", f"action '{self.plugin.name}' {what} succeeded after failing ({error})")
+
+
+class _Watchdog:
+    """One thread for every runner: it reads the call each runner has in progress, so a plugin call
+    that never returns is reported without any help from the thread it holds."""
+
+    def __init__(self) -> None:
+        self._lock = threading.Lock()
+        self._runners: "weakref.WeakSet[ActionRunner]" = weakref.WeakSet()
+        self._thread: Optional[threading.Thread] = None
+
+    def add(self, runner: ActionRunner) -> None:
+        with self._lock:
+            self._runners.add(runner)
+            if self._thread is None or not self._thread.is_alive():
+                self._thread = threading.Thread(target=self._run, name="rubass-action-watchdog", daemon=True)
+                self._thread.start()
+
+    def discard(self, runner: ActionRunner) -> None:
+        with self._lock:
+            self._runners.discard(runner)
+
+    def _run(self) -> None:
+        while True:
+            time.sleep(WATCH_EVERY)
+            with self._lock:
+                runners = list(self._runners)
+            for runner in runners:
+                try:
+                    runner.stuck(time.monotonic())
+                except Exception:  # noqa: BLE001 - a log callback that fails must not end the watch
+                    pass
+
+
+_WATCHDOG = _Watchdog()
