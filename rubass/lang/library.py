@@ -218,8 +218,9 @@ def load_library(path: str, sources: SourceSet) -> Tuple[Dict[str, ActionDef], L
     actions, diags = parse_library(src)
     earlier = _LOADED.setdefault(sources, [])
     clashes = _clashes(earlier, actions)
-    earlier.extend(a for a in actions.values() if a not in earlier)
-    return {k: a for k, a in actions.items() if a.span not in {d.span for d in clashes}}, diags + clashes
+    kept = {k: a for k, a in actions.items() if k not in {d.subject for d in clashes}}
+    earlier.extend(a for a in kept.values() if a not in earlier)
+    return kept, diags + clashes
 
 
 # the actions of the libraries already loaded in one run (one SourceSet), for conflicts across them
