@@ -383,7 +383,7 @@ def _limit_problems(where: str, span: Span, params: Dict[str, Any], fields: Dict
     if not any(params.get(axis) for axis in LIMIT_AXES):
         out.append(Diagnostic(span, f"{where}: a limit action needs at least one axis range "
                                     f"({', '.join(LIMIT_AXES)}), such as 'linear_x: [-0.1 m/s, 0.2 m/s]'"))
-    if params["input"] == params["topic"]:
+    if resolve_topic(params["input"]) == resolve_topic(params["topic"]):  # spellings of one topic too
         out.append(Diagnostic(fields["topic"][1].span, f"{where}: 'topic' must differ from 'input' "
                                                        f"({params['input']}): it would filter its own output"))
     return out

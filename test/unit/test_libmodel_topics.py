@@ -131,3 +131,8 @@ def test_a_service_type_typo_suggests_the_installed_type_of_its_package(tmp_path
     status, out = run_check(tmp_path, capsys, library, ["h", "i"])
     assert status == 1
     assert "unknown service type 'std_srvs/Trigerr'" in out and "did you mean 'std_srvs/Trigger'?" in out, out
+
+
+def test_a_limit_whose_topic_is_a_spelling_of_its_input_is_an_error():
+    _, diags = lib("actions:\n  c: {plugin: limit, input: cmd_vel, topic: /cmd_vel/, linear_x: [0, 0.1 m/s]}\n")
+    assert diags == ["2:45: action 'c': 'topic' must differ from 'input' (cmd_vel): it would filter its own output"]
