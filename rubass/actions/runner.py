@@ -27,6 +27,12 @@ _RESOLVED_BY = {"start": ("start", "release"), "release": ("release", "start"),
                 "hold": ("hold", "start", "release"), "periodic": ("periodic",), "input": ()}
 
 
+class Skipped(Exception):
+    """Raised by a plugin's phase that did nothing this time by design, neither a success nor a failure
+    (not counted, resolves nothing; a start or release is retried): a hold while the serial board is
+    away between two reopen attempts, or while the previous call of a service has not returned."""
+
+
 class ActionRunner:
     def __init__(self, plugin: ActionPlugin, log: Log) -> None:
         self.plugin = plugin
@@ -251,6 +257,9 @@ class ActionRunner:
             self._call = (what, time.monotonic())
         try:
             fn()
+        except Skipped:
+            self._returned()
+            return False
         except Exception as exc:  # a plugin's failure must never reach the engine
             self._returned()
             self.stats.failures += 1

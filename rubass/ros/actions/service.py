@@ -1,14 +1,17 @@
-"""The `service` plugin: calls a ROS service with fixed request fields, with a timeout."""
+"""The `service` plugin: calls a ROS service with fixed request fields, with a timeout; at most one
+abandoned (hung) call per action is ever in flight."""
 from __future__ import annotations
 
 import threading
-from typing import Any, List
+import time
+from typing import Any, List, Optional, Tuple
 
 import rosgraph
 import roslib.message
 import rospy
 
 from ...actions.base import ActionPlugin, Context
+from ...actions.runner import Skipped
 from ..rpc import proxy
 from .publish import build_message, ros_class
 
@@ -19,22 +22,47 @@ class ServicePlugin(ActionPlugin):
         self.request = build_message(cls._request_class, self.params.get("request") or {},
                                      f"action '{self.name}': request")
         self.proxy = rospy.ServiceProxy(self.params["service"], cls)
+        self.call_timeout = float(self.params["timeout"]) + 1.0  # the runner's stuck bound: the call and _advertised
+        # the abandoned call while it has not returned: (thread, monotonic start, its stage)
+        self._hung: Optional[Tuple[threading.Thread, float, List[str]]] = None
 
-    def _call(self) -> None:
-        """Call with a timeout; a call that hangs is abandoned (its thread is a daemon)."""
+    def _previous_returned(self, phase: str) -> None:
+        """Raise while the call abandoned last time is still in the service (a wait for the service
+        that overran the timeout ends on its own within rospy's 0.3 s poll: waited for): a start or
+        release fails at once, a hold (every tick) is skipped, not counted as another failure."""
+        if self._hung is None:
+            return
+        thread, since, stage = self._hung
+        if stage[0] == "waiting":
+            thread.join(0.4)
+        if thread.is_alive():
+            text = (f"the previous call to {self.params['service']} has not returned after "
+                    f"{time.monotonic() - since:.1f} s: not calling it again until it does")
+            raise Skipped(text) if phase == "hold" else TimeoutError(text)
+        self._hung = None
+
+    def _call(self, phase: str) -> None:
+        """Call with a timeout; a call that hangs is abandoned (its thread is a daemon), and while it has
+        not returned no other is started: a new attempt fails at once (one thread per attempt leaked)."""
         timeout = float(self.params["timeout"])
+        self._previous_returned(phase)
         result: List[Any] = []
+        stage = ["waiting"]  # then "calling": a wait for the service ends on its own (rospy polls it every 0.3 s)
 
         def call() -> None:
             try:  # a service that appears within the timeout (its node restarting) is called at once
                 self.proxy.wait_for_service(timeout)
+                stage[0] = "calling"
                 result.append(self.proxy.call(self.request))
             except Exception as exc:  # rospy.ServiceException, ROSException, ROSInterruptException
                 result.append(exc)
 
         worker = threading.Thread(target=call, name=f"rubass-service-{self.name}", daemon=True)
         worker.start()
+        started = time.monotonic()
         worker.join(timeout)
+        if worker.is_alive():
+            self._hung = (worker, started, stage)
         if not result or type(result[0]) is rospy.ROSException:  # timed out: waiting for it, or in the call
             if not self._advertised():  # asked only now, to say why
                 raise IOError(f"service {self.params['service']} does not exist (not advertised on the master)")
@@ -53,15 +81,15 @@ class ServicePlugin(ActionPlugin):
 
     def start(self, ctx: Context) -> None:
         if "start" in self.params["call_on"]:
-            self._call()
+            self._call("start")
 
     def hold(self, ctx: Context) -> None:
         if "hold" in self.params["call_on"]:
-            self._call()
+            self._call("hold")
 
     def release(self, ctx: Context) -> None:
         if "release" in self.params["call_on"]:
-            self._call()
+            self._call("release")
 
     def close(self) -> None:
         self.proxy.close()
