@@ -23,6 +23,17 @@ class Reaction:
     source: str
     cases: int
 
+    def figures(self) -> str:
+        """The figures as what they are: one case's, or the largest of each over several cases (the p50
+        shown is then no median of anything: the slowest case's)."""
+        if self.cases == 1:
+            return f"p50 {self.p50_ms:g} ms, p99 {self.p99_ms:g} ms, worst {self.worst_ms:g} ms"
+        return (f"largest p50 {self.p50_ms:g} ms, largest p99 {self.p99_ms:g} ms and worst {self.worst_ms:g} ms "
+                f"over {self.cases} cases")
+
+    def p99_label(self) -> str:
+        return "p99" if self.cases == 1 else f"largest p99 of {self.cases} cases"
+
 
 class BenchError(RubassError):
     """A benchmark file given with --bench that cannot be used; the message names the file and why."""
@@ -75,19 +86,32 @@ def from_readme(path: str = README) -> Optional[Reaction]:
             text = fh.read()
     except OSError:
         return None
-    section = text.split("## reaction.py", 1)
-    if len(section) < 2:
+    head = re.search(r"^## reaction\.py", text, re.M)
+    if head is None:
         return None
-    body = section[1].split("\n## ", 1)[0]
+    start = head.end()
+    end = re.compile(r"^#{1,2} ", re.M).search(text, start)
+    body = text[start:end.start() if end else len(text)]
     rows: List[List[float]] = []
+    first_row = -1
     for m in re.finditer(r"^\|[^|\n]*\|[^|\n]*\|[^|\n]*\|\s*([\d.]+)\s*/\s*([\d.]+)\s*/\s*([\d.]+)\s*ms\s*\|", body, re.M):
         rows.append([float(m.group(1)), float(m.group(2)), float(m.group(3))])
+        first_row = m.start() if first_row < 0 else first_row
     if not rows:
         return None
-    dated = re.search(r"Figures of (\d{4}-\d\d-\d\d)", text)
-    when = f", figures of {dated.group(1)}" if dated else ""
+    when = _date_of(text, start + first_row)
     return Reaction(max(r[2] for r in rows), max(r[1] for r in rows), max(r[0] for r in rows),
                     f"bench/README.md (bench/reaction.py{when})", len(rows))
+
+
+def _date_of(text: str, pos: int) -> str:
+    """", figures of DATE": the last "Figures of DATE" before `pos` in the part (top-level `#` section) of
+    the README that holds it; "" when that part dates nothing."""
+    part = 0
+    for m in re.finditer(r"^# ", text[:pos], re.M):
+        part = m.start()
+    dates = re.findall(r"Figures of (\d{4}-\d\d-\d\d)", text[part:pos])
+    return f", figures of {dates[-1]}" if dates else ""
 
 
 def measured(path: Optional[str] = None) -> Optional[Reaction]:

@@ -68,6 +68,7 @@ def run(args: argparse.Namespace) -> int:
     outcomes = ev.outcomes
     failed = sum(not o.passed for o in outcomes)
     gaps = sum(1 for row in ev.matrix if row.gaps)
-    print(f"report written to {args.output}: {len(outcomes) - failed} tests passed, {failed} failed, "
+    ok = len(outcomes) - failed
+    print(f"report written to {args.output}: {ok} test{'s' if ok != 1 else ''} passed, {failed} failed, "
           f"{gaps} gap{'s' if gaps != 1 else ''} in the matrix")
     return 1 if failed or any(r.error for r in results) or any(b.error for b in bags) else 0

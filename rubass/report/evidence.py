@@ -156,33 +156,43 @@ def build_matrix(ev: Evidence) -> None:
         rules = [r for r in spec.rules if h.id in attrs(r).get("hazard", ())]
         direct_b = [b for b in spec.behaviours if h.id in attrs(b).get("hazard", ())]
         if not rules and not direct_b:
-            ev.matrix.append(Row(h, None, [], [o for o in outcomes if h.id in o.covers], ["no rule"]))
+            tests = covering(outcomes, [h.id])
+            ev.matrix.append(Row(h, None, [], tests, ["no rule"] + _failing(tests)))
             continue
         for r in rules:
             users = [b for b in spec.behaviours if r.key in uses[b.index]]
-            ids = set(rule_ids_of(spec, r))
-            tests = [o for o in outcomes if ids & set(o.covers)]  # tests that name the rule's (or entity's) @id
-            if not tests:  # else the tests that made it true (weaker evidence, but evidence)
-                tests = [o for o in outcomes if r.key in o.rules_true]
-            ev.matrix.append(Row(h, r.key, [behaviour_label(spec, b.index) for b in users], tests, _gaps(users, tests)))
+            ids = list(rule_ids_of(spec, r))
+            ev.matrix.append(_row(h, r.key, [behaviour_label(spec, b.index) for b in users], ids, outcomes, not users))
         for b in direct_b:
             if any(r.key in uses[b.index] for r in rules):
                 continue  # shown with its rule
-            ids = set(attrs(b).get("id", ()))
-            tests = [o for o in outcomes if ids & set(o.covers)] or [o for o in outcomes if b.index in o.started]
-            ev.matrix.append(Row(h, None, [behaviour_label(spec, b.index)], tests, _gaps([b], tests)))
+            ids = list(attrs(b).get("id", ()))
+            ev.matrix.append(_row(h, None, [behaviour_label(spec, b.index)], ids, outcomes, False))
     if outcomes:
         ev.coverage = coverage(spec, outcomes)
 
 
-def _gaps(users: List[Any], tests: List[Outcome]) -> List[str]:
-    gaps = []
-    if not users:
-        gaps.append("no behaviour acts on it")
+def covering(outcomes: List[Outcome], names: Sequence[str]) -> List[Outcome]:
+    """The tests whose `covers` names one of `names`: the one meaning of "covered", shared with
+    `rubass test --coverage` (a test that only happens to make a rule true covers nothing)."""
+    return [o for o in outcomes if set(names) & set(o.covers)]
+
+
+def _row(h: Hazard, rule: Optional[str], behaviours: List[str], ids: List[str], outcomes: List[Outcome],
+         no_behaviour: bool) -> Row:
+    """A matrix row: the tests that cover the rule's (or behaviour's) ids, or the hazard when it has no id;
+    a gap for each of those names and the hazard that no test covers, as the coverage lists them."""
+    tests = covering(outcomes, ids or [h.id])
+    gaps = ["no behaviour acts on it"] if no_behaviour else []
     if not tests:
-        gaps.append("no test")
-    gaps += [f"test '{o.name}' fails" for o in tests if not o.passed]
-    return gaps
+        gaps.append(f"no test covers {' or '.join(ids)}" if ids else f"no test (none covers {h.id})")
+    if ids and not covering(outcomes, [h.id]):
+        gaps.append(f"no test covers hazard {h.id}")
+    return Row(h, rule, behaviours, tests, gaps + _failing(tests))
+
+
+def _failing(tests: List[Outcome]) -> List[str]:
+    return [f"test '{o.name}' fails" for o in tests if not o.passed]
 
 
 def replay_bag(spec: CheckedSpec, path: str, rate: float = 50.0) -> BagRun:

@@ -75,7 +75,8 @@ def render(ev: Evidence) -> str:
            f"<h1>Safety evidence for <code>{_e(os.path.basename(spec.path))}</code></h1>",
            f"<p class='muted'>{_e(spec.path)} · generated {now} by rubass report on {_e(platform.node())} "
            f"({_e(platform.machine())}, Python {_e(platform.python_version())})</p>"]
-    reaction = (f"<b>≤ {ev.reaction.worst_ms:g} ms</b>worst case measured (p99 {ev.reaction.p99_ms:g} ms)"
+    reaction = (f"<b>≤ {ev.reaction.worst_ms:g} ms</b>worst case measured ({_e(ev.reaction.p99_label())} "
+                f"{ev.reaction.p99_ms:g} ms)"
                 if ev.reaction else "<b>n/a</b>no benchmark figures")
     out.append("<div class='summary'>"
                f"<div class='card'><b>{len(ev.hazards)}</b>hazard{'s' if len(ev.hazards) != 1 else ''}</div>"
@@ -105,8 +106,11 @@ def _matrix(ev: Evidence) -> str:
         rows.append(f"<tr><td><b>{_e(h.id)}</b> {_e(h.title)}<br><span class='muted'>{_e(details)}</span></td>"
                     f"<td>{rule_cell}</td><td>{_list(row.behaviours)}</td><td>{tests}</td>{status}</tr>")
     note = ("<p>Each hazard of the risk assessment, the rules that detect it (<code>@hazard</code>), the behaviours "
-            "that act on those rules, and the tests that cover them (those whose <code>covers</code> names the rule's "
-            "<code>@id</code>, or its entity's when the rule has none; when none does, those that made the rule true). Gaps are marked red: a hazard with no rule, a rule with no test, a failing test.</p>")
+            "that act on those rules, and the tests that cover them. <b>Covered</b> means named in a test's "
+            "<code>covers</code>, as in the coverage below: a rule by its <code>@id</code> (its entity's when it has "
+            "none; the hazard's when neither has one), and the hazard by its own id. A test that only makes a rule true "
+            "covers nothing. Gaps are marked red: a hazard with no rule, a rule or hazard no test covers, a failing "
+            "test, a rule no behaviour acts on.</p>")
     return "<h2 id='matrix'>Hazard → rule → behaviour → test</h2>" + note + \
         _table(["hazard", "rule", "behaviours", "tests", "status"], rows)
 
@@ -118,8 +122,7 @@ def _reaction_note(ev: Evidence) -> str:
     return (f"<p>Every rule's reaction by design is the time on its slowest path (<code>for</code>, <code>age(…) &gt; T</code>, "
             f"through the rules it uses; see Behaviours). The monitor "
             f"adds its own reaction, measured on this machine from the violating message to the stop received by "
-            f"the base: p50 {r.p50_ms:g} ms, p99 {r.p99_ms:g} ms, <b>worst {r.worst_ms:g} ms</b> over {r.cases} "
-            f"cases (source: {_e(r.source)}).</p>")
+            f"the base: <b>{_e(r.figures())}</b> (source: {_e(r.source)}).</p>")
 
 
 def _rules(ev: Evidence) -> str:

@@ -54,15 +54,19 @@ def run(args: argparse.Namespace) -> int:
             spec = rs[0].spec
             assert spec is not None
             print(render(coverage(spec, [o for r in rs for o in r.outcomes])))
+    junit_error = ""
     if args.junit:
         from .junit import write_junit
 
         try:
             write_junit(results, args.junit)
         except OSError as exc:
-            print(f"rubass test: error: cannot write {args.junit}: {exc.strerror or exc}", file=sys.stderr)
-            return 2
-    print(f"{passed} passed, {failed} failed")
+            junit_error = f"rubass test: error: cannot write {args.junit}: {exc.strerror or exc}"
+    print(f"{passed} passed, {failed} failed")  # the last line, even when the XML could not be written
+    if junit_error:
+        sys.stdout.flush()
+        print(junit_error, file=sys.stderr)
+        return 2
     if any(r.error for r in results):
         return 2
     return 1 if failed else 0

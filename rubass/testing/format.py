@@ -8,8 +8,8 @@ from typing import Any, Dict, List, Optional, Tuple
 
 from ..lang.errors import did_you_mean
 from ..lang.units import MEMORY, TIME, FREQUENCY, parse_quantity
-from .messages import MessageError, Path, fields_of, message_class, parse_path
-from .series import GAP, SeriesError, expand
+from .messages import MessageError, Path, field_info, fields_of, message_class, parse_path
+from .series import GAP, UNKNOWN, SeriesError, expand
 from .yamlpos import LDict, LList, TestFileError, load
 
 UNSET: Any = object()  # a node-sample value the sample leaves out
@@ -68,6 +68,7 @@ class Case:
     messages: List[MessageInput] = field(default_factory=list)
     nodes: List[NodeSampleInput] = field(default_factory=list)
     expects: List[Expect] = field(default_factory=list)
+    covers_lines: List[int] = field(default_factory=list)  # the line of each `covers` value
 
     @property
     def end(self) -> float:
@@ -93,6 +94,7 @@ class _Reader:
     def __init__(self, path: str) -> None:
         self.path = path
         self.registry: Any = None  # message definitions of the system model, when the file names one
+        self.sysmodel: Any = None  # the system model itself (its unit tables)
 
     def fail(self, line: int, message: str) -> TestFileError:
         return TestFileError(self.path, line, message)
@@ -102,7 +104,7 @@ class _Reader:
             raise self.fail(line, f"{what} must be a mapping")
         for k in value:
             if k not in keys:
-                raise self.fail(value.at(k), f"unknown key '{k}' in {what}{did_you_mean(str(k), keys)}"
+                raise self.fail(value.key_at(k), f"unknown key '{k}' in {what}{did_you_mean(str(k), keys)}"
                                               f" (keys: {', '.join(keys)})")
         for k in required:
             if k not in value:
@@ -148,6 +150,7 @@ class _Reader:
         actions = [os.path.join(base, str(a)) for a in listed]
         model = self.model(top, base) if "model" in top else None
         self.registry = model.registry if model is not None else None
+        self.sysmodel = model
         tests = self.seq(top["tests"], top.at("tests"), "tests")
         if not tests:
             raise self.fail(top.at("tests"), "tests is empty: a file needs at least one test")
@@ -178,11 +181,10 @@ class _Reader:
         t = self.mapping(value, line, "a test", ("name", "covers", "duration", "topics", "nodes", "expect",
                                                  "tolerance"))
         name = str(t.get("name", f"test {i + 1}"))
-        covers = t.get("covers", LList())
-        covers = [covers] if isinstance(covers, str) else self.seq(covers, t.at("covers"), "covers")
+        covers, covers_lines = self.covers(t)
         duration = self.time(t["duration"], t.at("duration"), "duration") if "duration" in t else None
         tol = self.time(t["tolerance"], t.at("tolerance"), "tolerance") if "tolerance" in t else DEFAULT_TOLERANCE
-        case = Case(name, t.line, [str(c) for c in covers], duration, tol)
+        case = Case(name, t.line, covers, duration, tol, covers_lines=covers_lines)
         topics = self.mapping(t.get("topics", LDict()), t.at("topics"), "topics", tuple(t.get("topics") or ()))
         for topic, spec in topics.items():
             self.topic(case, str(topic), spec, topics.at(topic))
@@ -191,7 +193,34 @@ class _Reader:
             self.node(case, str(node), samples, nodes.at(node))
         expects = self.seq(t.get("expect", LList()), t.at("expect"), "expect")
         case.expects = [self.expect(e, expects.at(k)) for k, e in enumerate(expects)]
+        if duration is not None:
+            for e in case.expects:
+                self.within_duration(e, duration, e.tolerance if e.tolerance is not None else tol)
         return case
+
+    def covers(self, t: LDict) -> Tuple[List[str], List[int]]:
+        """The @id / @hazard values a test names, each with its line; a value that is no name (null, a
+        mapping, true, 1.5) is an error rather than a name nobody wrote."""
+        value = t.get("covers", LList())
+        if isinstance(value, (str, int)) and not isinstance(value, bool):
+            return [str(value)], [t.at("covers")]
+        items = self.seq(value, t.at("covers"), "covers")
+        out: List[str] = []
+        for k, v in enumerate(items):
+            if isinstance(v, bool) or not isinstance(v, (str, int)) or v == "":
+                shown = "an empty entry" if v is None or v == "" else f"{v!r}"
+                raise self.fail(items.at(k), f"covers lists @id and @hazard values of the spec: {shown} is not "
+                                             f"one (write it as in the spec, quoted: covers: [\"SR-1\", \"H1\"])")
+            out.append(str(v))
+        return out, [items.at(k) for k in range(len(items))]
+
+    def within_duration(self, e: Expect, duration: float, tol: float) -> None:
+        """An expectation the test cannot see (after its end) is an error at its line, not a verdict."""
+        last = e.at if e.kind in ("start", "release") else e.end if e.kind == "active" else 0.0
+        if last > duration + tol:
+            what = f"{e.kind} at {last:g} s" if e.kind != "active" else f"active until {last:g} s"
+            raise self.fail(e.line, f"{what} is after the test's end (duration {duration:g} s): the test cannot "
+                                    f"see it; lengthen duration or end the expectation by {duration:g} s")
 
     def topic(self, case: Case, topic: str, value: Any, line: int) -> None:
         if not topic.startswith("/"):
@@ -225,23 +254,27 @@ class _Reader:
         if "field" in t:
             if "values" not in t:
                 raise self.fail(t.line, f"the series of {topic} needs values")
-            columns = [(t["field"], t["values"], t.at("field"), t.at("values"))]
+            columns = [(t["field"], t["values"], t.key_at("field"), t.at("values"))]
         else:
             if "values" in t:
                 raise self.fail(t.at("values"), "with fields, give the values per field: fields: {PATH: VALUES}")
             fields = self.mapping(t["fields"], t.at("fields"), "fields", tuple(t["fields"] or ()))
-            columns = [(k, v, fields.at(k), fields.at(k)) for k, v in fields.items()]
+            columns = [(k, v, fields.key_at(k), fields.at(k)) for k, v in fields.items()]
             if not columns:
                 raise self.fail(t.at("fields"), f"the series of {topic} has no fields")
         steps: List[Tuple[Path, List[Any]]] = []
+        lines: List[int] = []
         for path_text, values, pline, vline in columns:
             try:
                 path = parse_path(path_text)
-                steps.append((path, expand(values)))
             except MessageError as exc:
                 raise self.fail(pline, str(exc)) from None
+            field_dim = self.field_dim(case.topics[topic], path, pline)
+            try:
+                steps.append((path, expand(values, field_dim, str(path_text))))
             except SeriesError as exc:
                 raise self.fail(vline, f"values of {path_text}: {exc}") from None
+            lines.append(vline)
         lengths = {len(s) for _, s in steps}
         if len(lengths) != 1:
             raise self.fail(t.at("fields"), f"the fields of {topic} have series of different lengths "
@@ -251,9 +284,35 @@ class _Reader:
             raise self.fail(t.line, f"more than {MAX_MESSAGES} messages in one test")
         for k in range(n):
             parts = [(path, s[k]) for path, s in steps if s[k] is not GAP]
+            if parts and len(parts) != len(steps):  # `_` is no message: it cannot be one field of one
+                gap = next(j for j, (_, s) in enumerate(steps) if s[k] is GAP)
+                valued = next(p for p, s in steps if s[k] is not GAP)
+                raise self.fail(lines[gap], f"step {k + 1} of {topic} (at {start + k / rate:g} s) is _ (no message) "
+                                            f"in {_path_text(steps[gap][0])} but a value in {_path_text(valued)}: "
+                                            f"a step with no message is _ in every field")
             if parts:
                 line = t.at("values") if "values" in t else t.at("fields")
                 case.messages.append(MessageInput(round(start + k / rate, 9), topic, parts, line))
+
+    def field_dim(self, t: TopicInput, path: Path, line: int) -> Any:
+        """The dimension of a series' field (series.UNKNOWN when no unit table gives it, None when it is
+        no number); a field the type lacks is an error at the field's line."""
+        from ..lang.std_units import STANDARD_UNITS
+
+        tables = (STANDARD_UNITS, self.sysmodel.units) if self.sysmodel is not None else (STANDARD_UNITS,)
+        topic_units = self.sysmodel.topic_units.get(t.topic) if self.sysmodel is not None else None
+        info = field_info(t.cls, path, tables, topic_units)
+        if info is None:
+            return UNKNOWN
+        if info.kind == "missing":
+            raise self.fail(line, f"{t.topic} ({t.type_name}): {info.why}")
+        if info.kind == "msg":
+            raise self.fail(line, f"{t.topic} ({t.type_name}): '{_path_text(path)}' is a message, not a value: "
+                                  f"{info.why}")
+        numeric = info.kind == "num" or (info.kind == "array" and info.elem_kind == "num")
+        if not numeric:
+            return None
+        return info.dim if info.dim is not None else UNKNOWN
 
     def message(self, case: Case, topic: str, value: Any, line: int) -> None:
         if not isinstance(value, LDict) or "at" not in value:
@@ -309,6 +368,10 @@ class _Reader:
             if out.end < out.start:
                 raise self.fail(e.at("to"), "to is before from")
         return out
+
+
+def _path_text(path: Path) -> str:
+    return "".join(f"[{p}]" if isinstance(p, int) else f".{p}" for p in path).lstrip(".")
 
 
 def read_test_file(path: str) -> TestFile:

@@ -15,6 +15,7 @@ from ..lang.errors import RubassError
 _ARRAY = re.compile(r"(.*)\[(\d*)\]$")
 _INTS = {"int8", "uint8", "int16", "uint16", "int32", "uint32", "int64", "uint64", "char", "byte"}
 _FLOATS = {"float32", "float64"}
+_NON_FINITE = ("nan", "inf", "-inf", "+inf")
 _PATH = re.compile(r"([A-Za-z_][A-Za-z0-9_]*)|\[(-?\d+)\]|(\.)")
 
 Path = Tuple[Any, ...]
@@ -111,6 +112,8 @@ def _nested_class(type_name: str) -> Any:
 
 def _scalar(slot: str, value: Any, where: str) -> Any:
     if slot in _FLOATS:
+        if isinstance(value, str) and value.strip().lower() in _NON_FINITE:  # as in series (TESTING.md)
+            return float(value.strip().lower())
         if isinstance(value, bool) or not isinstance(value, (int, float)):
             raise MessageError(f"{where} is a {slot}: {value!r} is not a number")
         return float(value)
@@ -211,3 +214,25 @@ def build(cls: Any, assignments: List[Tuple[Path, Any]], stamp: Optional[float])
 def fields_of(mapping: Dict[str, Any]) -> List[Tuple[Path, Any]]:
     """The assignments of an explicit message's mapping (each top-level key one assignment)."""
     return [(parse_path(str(k)), v) for k, v in mapping.items()]
+
+
+_REGISTRIES: Dict[str, Any] = {}  # message definitions by type, built from the classes' full text
+
+
+def field_info(cls: Any, path: Path, tables: Any = (), topic_units: Any = None) -> Any:
+    """What the spec's checker knows of `path` in messages of `cls` (rubass.lang.fieldmodel.FieldInfo:
+    its kind, 'missing' with why, and its dimension from the unit tables); None when the type's
+    definition cannot be read."""
+    from ..lang.msgdef import Registry
+    from ..lang.msgpath import resolve
+
+    type_name = getattr(cls, "_type", "")
+    registry = _REGISTRIES.get(type_name)
+    if registry is None:
+        try:
+            registry = Registry()
+            registry.add_full(type_name, cls._full_text)
+        except Exception:  # a definition the parser cannot read: the setters still check every value
+            return None
+        _REGISTRIES[type_name] = registry
+    return resolve(registry, type_name, path, tables, topic_units)

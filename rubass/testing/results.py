@@ -37,9 +37,12 @@ def run_file(path: str, extra_actions: Sequence[str] = ()) -> FileResult:
         result.spec = spec
         prepared = [prepare(spec, c, path, result.warnings) for c in tf.cases]
         for c in tf.cases:
-            for name in unknown_covers(spec, c.covers):
-                result.warnings.append(f"{path}:{c.line}: warning: test '{c.name}' covers '{name}', "
-                                       f"which is no @id or @hazard of the spec")
+            unknown = set(unknown_covers(spec, c.covers))
+            for k, name in enumerate(c.covers):
+                if name in unknown:
+                    line = c.covers_lines[k] if k < len(c.covers_lines) else c.line
+                    result.warnings.append(f"{path}:{line}: warning: test '{c.name}' covers '{name}', "
+                                           f"which is no @id or @hazard of the spec")
     except TestFileError as exc:
         result.error = exc.render()
         return result

@@ -107,7 +107,7 @@ def _stream(spec: CheckedSpec, case: Case, path: str, warnings: List[str]) -> Li
                 assign(msg, ("header", "stamp"), EPOCH + time)
         except MessageError:
             pass
-        for part in parts:
+        for part in sorted(parts, key=lambda part: part.line):  # the later entry in the file wins per field
             try:
                 for fpath, value in part.assignments:
                     assign(msg, fpath, _test_time(fpath, value))
@@ -188,16 +188,19 @@ def timeline(spec: CheckedSpec, events: List[Event], target: Tuple[str, Any]) ->
     return out
 
 
-def _intervals(tl: List[Tuple[str, float]], end: float) -> List[Tuple[float, float]]:
-    out, since = [], None
+def _intervals(tl: List[Tuple[str, float]], end: float) -> List[Tuple[float, float, bool]]:
+    """The spans (from, to, still open) a behaviour or action is active; one still open at the test's
+    end ends there: the test saw nothing after it."""
+    out: List[Tuple[float, float, bool]] = []
+    since: Optional[float] = None
     for kind, t in tl:
         if kind == "start" and since is None:
             since = t
         elif kind == "release" and since is not None:
-            out.append((since, t))
+            out.append((since, t, False))
             since = None
     if since is not None:
-        out.append((since, float("inf")))
+        out.append((since, end, True))
     return out
 
 
@@ -247,7 +250,9 @@ def execute(p: Prepared) -> Outcome:
         actual = timeline(spec, events, target)
         if not _match(actual, exps, case.tolerance):
             expected = sorted(((e.kind, e.at) for e in exps), key=lambda x: x[1])
-            out.problems.append(f"{resolver.label(target)}:\n      expected: {_fmt(expected)}\n"
+            lines = sorted({e.line for e in exps})
+            where = f"line{'s' if len(lines) > 1 else ''} {', '.join(str(n) for n in lines)}"
+            out.problems.append(f"{resolver.label(target)} ({where}):\n      expected: {_fmt(expected)}\n"
                                 f"      actual:   {_fmt(actual)}")
     for exp, target in targets:
         tol = exp.tolerance if exp.tolerance is not None else case.tolerance
@@ -259,9 +264,9 @@ def execute(p: Prepared) -> Outcome:
                                     f"but: {_fmt(actual)}")
         elif exp.kind == "active":
             spans = _intervals(actual, end)
-            if not any(a <= exp.start + tol and b >= exp.end - tol for a, b in spans):
-                shown = ", ".join(f"[{a:.3f}, {b:.3f}]" if b != float("inf") else f"[{a:.3f}, end]"
-                                  for a, b in spans) or "never"
+            if not any(a <= exp.start + tol and b >= exp.end - tol for a, b, _ in spans):
+                shown = ", ".join(f"[{a:.3f}, {b:.3f}]" + (" (still active at the test's end)" if open_ else "")
+                                  for a, b, open_ in spans) or "never"
                 out.problems.append(f"{resolver.label(target)}: expected active (line {exp.line}) throughout "
                                     f"[{exp.start:.3f}, {exp.end:.3f}] s, but active: {shown}")
     out.passed = not out.problems

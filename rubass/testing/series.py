@@ -10,7 +10,7 @@ import re
 from typing import Any, List
 
 from ..lang.errors import RubassError
-from ..lang.units import parse_quantity
+from ..lang.units import UNITS, dimension_name
 
 GAP: Any = object()  # a step with no message
 
@@ -27,8 +27,16 @@ class SeriesError(RubassError, ValueError):
     """A word of a series that is not one of the forms; the message says which and why."""
 
 
-def value(word: str) -> Any:
-    """One value word as a message value (float, bool or str)."""
+UNKNOWN: Any = object()  # a field whose dimension no unit table gives: any unit is converted to SI
+
+
+def _units_of(d: Any) -> str:
+    return ", ".join(u for u, (_, ud) in UNITS.items() if ud == d)
+
+
+def value(word: str, field_dim: Any = UNKNOWN, field: str = "the field") -> Any:
+    """One value word as a message value (float, bool or str). A number with a unit is converted to SI;
+    the unit must be of the field's dimension when it is known (`field_dim`, None: a number with none)."""
     low = word.lower()
     if low in ("nan", "inf", "-inf", "+inf"):
         return float(low)
@@ -37,18 +45,36 @@ def value(word: str) -> Any:
     if len(word) >= 2 and word[0] == word[-1] and word[0] in "\"'":
         inner = word[1:-1]
         return re.sub(r"\\(.)", r"\1", inner) if word[0] == '"' else inner
-    q = parse_quantity(word)
-    if q is None:
+    m = re.fullmatch(rf"({_NUM})(\S*)", word)
+    if m is None:
         raise SeriesError(f"'{word}' is not a value (a number, nan, inf, true, false or a quoted string)")
-    return q[0]
+    number, unit = float(m.group(1)), m.group(2)
+    if not unit:
+        return number
+    known = field_dim is not UNKNOWN and field_dim is not None
+    if unit not in UNITS:
+        hint = f" (units of a {dimension_name(field_dim)}: {_units_of(field_dim)})" if known and _units_of(field_dim) \
+            else ""
+        raise SeriesError(f"'{word}': '{unit}' is not a unit rubass knows{hint}")
+    factor, udim = UNITS[unit]
+    if known and udim != field_dim:
+        raise SeriesError(f"'{word}' is a {dimension_name(udim)} ({unit}), but {field} is a "
+                          f"{dimension_name(field_dim)} (units: {_units_of(field_dim) or 'none'})")
+    if field_dim is None:
+        raise SeriesError(f"'{word}' has a unit ({unit}), but {field} is not a number with a unit: "
+                          f"write the value alone")
+    return number * factor
 
 
-def expand(text: Any) -> List[Any]:
-    """The steps of a series: values, or GAP where no message is sent."""
+def expand(text: Any, field_dim: Any = UNKNOWN, field: str = "the field") -> List[Any]:
+    """The steps of a series: values, or GAP where no message is sent. `field_dim`: the dimension of
+    the field it sets (UNKNOWN when no table gives it; None for a number without unit, a bool or a
+    string), against which a value's unit is checked."""
     if isinstance(text, list):
         out: List[Any] = []
         for item in text:
-            out.extend(expand(item) if isinstance(item, str) else [item if item is not None else GAP])
+            out.extend(expand(item, field_dim, field) if isinstance(item, str)
+                       else [item if item is not None else GAP])
         return out
     if isinstance(text, bool) or isinstance(text, (int, float)):
         return [float(text) if not isinstance(text, bool) else text]
@@ -56,7 +82,7 @@ def expand(text: Any) -> List[Any]:
         raise SeriesError("values must be a string of words or a list")
     steps: List[Any] = []
     for word in _WORD.findall(text):
-        steps.extend(_word(word))
+        steps.extend(_word(word, field_dim, field))
         if len(steps) > _MAX_STEPS:
             raise SeriesError(f"more than {_MAX_STEPS} steps")
     if not steps:
@@ -64,7 +90,7 @@ def expand(text: Any) -> List[Any]:
     return steps
 
 
-def _word(word: str) -> List[Any]:
+def _word(word: str, field_dim: Any, field: str) -> List[Any]:
     if word[0] in "\"'":
         m = _QUOTED_WORD.fullmatch(word)
         if m is None:  # an opening quote never closed
@@ -84,8 +110,8 @@ def _word(word: str) -> List[Any]:
         return [round(a + k * b, 12) for k in range(n)]  # 0.1 * 3 is 0.3 here, as the author meant
     m = _REPEAT.fullmatch(word)
     if m:
-        return _repeat(word, GAP if m.group(1) == "_" else value(m.group(1)), int(m.group(2)))
-    return [value(word)]
+        return _repeat(word, GAP if m.group(1) == "_" else value(m.group(1), field_dim, field), int(m.group(2)))
+    return [value(word, field_dim, field)]
 
 
 def _repeat(word: str, v: Any, n: int) -> List[Any]:

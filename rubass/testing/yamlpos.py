@@ -27,9 +27,15 @@ class LDict(dict):  # type: ignore[type-arg]
     def __init__(self) -> None:
         super().__init__()
         self.lines: Dict[Any, int] = {}
+        self.key_lines: Dict[Any, int] = {}
 
     def at(self, key: Any) -> int:
+        """The line of a key's value (a block value starts below its key)."""
         return self.lines.get(key, self.line)
+
+    def key_at(self, key: Any) -> int:
+        """The line of the key itself."""
+        return self.key_lines.get(key, self.at(key))
 
 
 class LList(list):  # type: ignore[type-arg]
@@ -63,6 +69,7 @@ def _mapping(loader: _Loader, node: yaml.MappingNode) -> LDict:
             raise TestFileError("", key_node.start_mark.line + 1, f"duplicate key '{key}'")
         out[key] = loader.construct_object(value_node, deep=True)
         out.lines[key] = value_node.start_mark.line + 1
+        out.key_lines[key] = key_node.start_mark.line + 1
     return out
 
 

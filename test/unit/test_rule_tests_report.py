@@ -73,7 +73,7 @@ def test_report_is_one_self_contained_page_with_the_gaps(inputs, tmp_path, capsy
                  "-o", out])
     printed = capsys.readouterr().out
     assert code == 1  # a test fails: the report is written, and the exit says so
-    assert "report written to" in printed and "1 tests passed, 1 failed" in printed
+    assert "report written to" in printed and "1 test passed, 1 failed" in printed
     html = open(out, encoding="utf-8").read()
     assert html.startswith("<!DOCTYPE html>") and html.rstrip().endswith("</html>")
     assert not re.search(r"<(script|link|img)\b", html)  # nothing fetched: readable offline

@@ -61,7 +61,7 @@ def test_coverage_lists_an_entity_id_no_test_covers(spec_path, write, capsys):
 
 
 def test_report_shows_the_entity_id_and_counts_its_tests(spec_path, write, tmp_path, capsys):
-    tests = write("e.test.yaml", TEST.format(covers="E-1"))
+    tests = write("e.test.yaml", TEST.format(covers="E-1, H1"))  # the rule by its entity's id, and its hazard
     out = str(tmp_path / "r.html")
     assert main(["report", spec_path, "--tests", tests, "-o", out]) == 0
     html = open(out, encoding="utf-8").read()
@@ -133,7 +133,7 @@ def test_a_hazard_given_twice_in_the_risk_table_is_an_error_with_its_line(spec_p
 
 
 def test_one_gap_and_one_hazard_are_singular(spec_path, write, tmp_path, capsys):
-    tests = write("e.test.yaml", TEST.format(covers="E-1"))
+    tests = write("e.test.yaml", TEST.format(covers="E-1, H1"))  # the rule by its entity's id, and its hazard
     out = str(tmp_path / "r.html")
     assert main(["report", spec_path, "--tests", tests, "-o", out]) == 0
     assert "1 gap in the matrix" in capsys.readouterr().out  # base.far: no test
