@@ -137,13 +137,14 @@ def _primitive_problem(ftype: str, v: Any) -> Optional[str]:
 
 
 def check_library_types(actions: Dict[str, ActionDef], sources: SourceSet, registry: Registry,
-                        looked_in: str = "installed packages", known: Iterable[str] = ()) -> List[Diagnostic]:
+                        looked_in: str = "installed packages", known: Iterable[str] = (),
+                        known_services: Iterable[str] = ()) -> List[Diagnostic]:
     """Errors for publish and service actions whose types or fields do not fit the definitions.
 
     `looked_in` says where types were looked for, for the message of an unknown type; `known`
-    are more type names to suggest from (those installed in its package)."""
+    and `known_services` are more names to suggest from (those installed in its package)."""
     diags: List[Diagnostic] = []
-    known = list(known)
+    known, known_services = list(known), list(known_services)
     for act in sorted(actions.values(), key=lambda a: (a.span.file, a.span.line)):
         if act.plugin not in ("publish", "service"):
             continue
@@ -165,7 +166,7 @@ def check_library_types(actions: Dict[str, ActionDef], sources: SourceSet, regis
             srv = registry.services.get(type_name)
             if srv is None:
                 diags.append(Diagnostic(type_span, f"action '{act.name}': unknown service type '{type_name}' "
-                                                   f"(not in {looked_in}){did_you_mean(type_name, list(registry.services) + known)}"))
+                                                   f"(not in {looked_in}){did_you_mean(type_name, list(registry.services) + known_services)}"))
                 continue
             if "request" in nodes:
                 c.message(srv[0], nodes["request"][1], "request")

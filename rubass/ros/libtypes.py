@@ -56,10 +56,10 @@ def add_installed(registry: Registry, msg_types: Iterable[str], srv_types: Itera
         registry.add_service(t, req[t + "Request"], resp[t + "Response"])
 
 
-def installed_names(registry: Registry, msgs: Iterable[str], srvs: Iterable[str]) -> List[str]:
+def installed_names(registry: Registry, msgs: Iterable[str], srvs: Iterable[str]) -> Tuple[List[str], List[str]]:
     """The installed message and service types of the packages of those not found, for a
     did-you-mean ('std_srvs/Trigerr': 'std_srvs/Trigger', not another type the library names)."""
-    out: List[str] = []
+    out: Dict[str, List[str]] = {"msg": [], "srv": []}
     wanted = {(t.split("/")[0], "msg") for t in msgs if registry.get(t) is None} | \
              {(t.split("/")[0], "srv") for t in srvs if t not in registry.services}
     for package, kind in sorted(wanted):
@@ -73,8 +73,8 @@ def installed_names(registry: Registry, msgs: Iterable[str], srvs: Iterable[str]
             cls = getattr(module, name, None)
             type_name = getattr(cls, "_type", None)
             if isinstance(type_name, str) and (kind == "msg") != hasattr(cls, "_request_class"):
-                out.append(type_name)
-    return out
+                out[kind].append(type_name)
+    return out["msg"], out["srv"]
 
 
 def try_installed(registry: Registry, msgs: Iterable[str], srvs: Iterable[str]) -> bool:
@@ -105,8 +105,8 @@ def library_errors(actions: Dict[str, ActionDef], sources: SourceSet, model: Opt
         return []  # nothing to check against
     where = " or ".join(([model.source] if model is not None else []) +
                         (["the message packages installed here"] if installed else []))
-    known = installed_names(registry, msgs, srvs) if installed else []
-    errors = check_library_types(actions, sources, registry, where, known)
+    known, known_services = installed_names(registry, msgs, srvs) if installed else ([], [])
+    errors = check_library_types(actions, sources, registry, where, known, known_services)
     if model is not None:
         errors += check_publish_topics(actions, sources, model.topics, model.source)
     return errors
