@@ -477,6 +477,7 @@ class Engine:
         store, nodes, rules = self.store, self._nodes, self.store.rules
         moved: Set[int] = set()  # nodes whose value changed in this run
         incremental, now = changed is not None, store.now
+        first_event, released = len(events), False
         for i in plan:
             node = nodes[i]
             if incremental and not node.volatile and not node.fresh and node.due > now \
@@ -520,6 +521,10 @@ class Engine:
                     self._holders.get(a, set()).discard(node.key)
                 self._sync_actions()
                 events.append(self._event(node, "release"))
+                released = True
+        if released and len(events) - first_event > 1:  # one instant: its starts before its releases, so an
+            events[first_event:] = sorted(events[first_event:], key=_release_last)  # action one behaviour hands to
+            # another in this instant stays on (no on_release, no restart); each node runs once here
 
     def _schedule(self, idx: int, node: _Node) -> None:
         deadlines = node.compiled.deadlines()
@@ -534,6 +539,10 @@ STAMP: Tuple[ast.PathElem, ...] = ("header", "stamp")
 _ABSENT = object()  # a rule not evaluated yet
 _INSTANT_OPS = (ForOp, WithinOp, LatchOp)  # operators whose value moves only at inputs and deadlines
 _NO_FIELDS: FrozenSet[int] = frozenset()  # a tick, a deadline, a node sample: no field changed
+
+
+def _release_last(e: Event) -> bool:
+    return e.kind == "release"
 
 
 def _stamp(value: Any) -> Any:
