@@ -257,7 +257,7 @@ class _Reader:
             columns = [(t["field"], t["values"], t.key_at("field"), t.at("values"))]
         else:
             if "values" in t:
-                raise self.fail(t.at("values"), "with fields, give the values per field: fields: {PATH: VALUES}")
+                raise self.fail(t.key_at("values"), "with fields, give the values per field: fields: {PATH: VALUES}")
             fields = self.mapping(t["fields"], t.at("fields"), "fields", tuple(t["fields"] or ()))
             columns = [(k, v, fields.key_at(k), fields.at(k)) for k, v in fields.items()]
             if not columns:

@@ -20,7 +20,7 @@ def _x(text: str) -> str:
 
 def _one_line(problem: str) -> str:
     """A problem on one line (a failure's message attribute): 'overspeed (line 12): expected: …; actual: …'."""
-    parts = [p.strip() for p in problem.splitlines() if p.strip()]
+    parts = [re.sub(r"\s+", " ", p.strip()) for p in problem.splitlines() if p.strip()]
     return (parts[0] + " " + "; ".join(parts[1:])).strip() if len(parts) > 1 else (parts[0] if parts else "")
 
 

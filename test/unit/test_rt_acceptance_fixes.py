@@ -278,7 +278,7 @@ def test_a_failed_start_names_its_lines_and_junit_parses(files, capsys, tmp_path
     assert case.get("name") == "bad\\x01name"
     message = case.find("failure").get("message")
     assert message == f"overspeed ({lines}): expected: start at 2.500 s, release at 3.000 s; " \
-                      f"actual:   start at 2.000 s, release at 3.000 s"
+                      f"actual: start at 2.000 s, release at 3.000 s"
 
 
 def test_junit_that_cannot_be_written_still_prints_the_count(files, capsys):
