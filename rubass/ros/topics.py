@@ -1,9 +1,11 @@
 """Dynamic subscriptions: one rospy.AnyMsg subscriber per topic the spec names, whatever its
 type. The type comes from each connection's header; messages are deserialised only for
 topics whose fields the spec reads; field paths are checked when a topic's type is first
-seen (and again when it changes)."""
+seen (and again when it changes; two types at once: topictypes.py). Subscriptions are made
+in the background (see TopicWatcher), never under a lock the engine or a callback takes."""
 from __future__ import annotations
 
+import queue
 import threading
 import time
 from dataclasses import dataclass, field
@@ -18,7 +20,9 @@ from ..engine.values import UNKNOWN
 from ..lang import ast
 from ..lang.fielduse import field_needs
 from ..lang.model import CheckedSpec
+from . import topictypes
 from .msgtypes import check_path
+from .topictypes import RECHECK
 
 _rostime = rospy.rostime
 
@@ -31,6 +35,7 @@ def ros_now() -> float:
 
 
 Submit = Callable[[str, float, Any, float, int], None]  # (spec topic, ROS time, message or None, wall, bytes)
+SubmitAll = Callable[[Tuple[str, ...], float, Any, float, int], None]  # every spelling of the topic at once
 Log = Callable[[str, str], None]
 
 
@@ -49,20 +54,43 @@ class TopicState:
     md5: str = ""
     messages: int = 0
     errors: List[str] = field(default_factory=list)
-    subscriber: Optional[rospy.Subscriber] = None
+    subscriber: Optional[rospy.Subscriber] = None  # None until the registrar has made it
     cls: Any = None
+    gone: bool = False  # a reload dropped it (its subscription is dropped by the registrar)
+    kinds: Dict[str, "topictypes.Kind"] = field(default_factory=dict)  # md5 -> a type seen now
+    callers: Dict[str, Tuple[str, float]] = field(default_factory=dict)  # publisher -> (md5, newest message)
+    mixed: Optional[str] = None  # while publishers of two types are on: what is wrong (a data error)
+    mixed_logged: float = float("-inf")
+    checked: float = 0.0  # wall time the types were last looked at
 
 
 class TopicWatcher:
-    def __init__(self, submit: Submit, log: Log) -> None:
+    """Subscriptions are made and dropped by a thread of their own (the registrar): rospy
+    retries a registration until the master answers, and holds its topic manager's lock
+    meanwhile. `_lock` guards `topics` only for moments and never while rospy or the master is
+    asked anything, so the engine's thread and the subscribers' callbacks never wait on the
+    master: the rules of the topics already subscribed go on being enforced while a reload's
+    new topic waits for the master (its values stay unknown until then)."""
+
+    SLOW = 1.0  # s: a registration that takes longer is logged (the master does not answer)
+
+    def __init__(self, submit: Submit, log: Log, submit_spellings: Optional[SubmitAll] = None) -> None:
         self.submit = submit
+        # every spelling of one message at one instant (one evaluation); without it, one submit each
+        self.submit_spellings = submit_spellings
         self.log = log
         self.topics: Dict[str, TopicState] = {}  # by resolved name
         self._lock = threading.Lock()
+        self._types_lock = threading.Lock()  # a topic's types (topictypes.py): no rospy call under it
         self._classes: Dict[str, Any] = {}  # md5 -> class
+        self._jobs: "queue.Queue[Optional[Tuple[str, TopicState]]]" = queue.Queue()
+        self._registrar: Optional[threading.Thread] = None
+        self._closed = False
 
-    def sync(self, spec: CheckedSpec) -> None:
-        """Subscribe to the spec's topics, unsubscribe from those it no longer names."""
+    def sync(self, spec: CheckedSpec, wait: float = 1.0) -> None:
+        """Subscribe to the spec's topics, unsubscribe from those it no longer names. Returns once
+        the registrar has done so, or after `wait` seconds (the master does not answer): the
+        subscriptions are then made when it does."""
         # relative, absolute and ~private names resolve once, by ROS rules, to one subscription:
         # every spelling of a topic in the spec gets the same messages (one value, not two topics)
         spellings: Dict[str, List[str]] = {}
@@ -81,11 +109,12 @@ class TopicWatcher:
                     merged.setdefault(path, []).extend(o for o in owners if o not in merged.get(path, []))
             users[names[0]] = merged
             stamp_only[names[0]] = frozenset(p for p in merged if not any(p in explicit[n] for n in names))
-        with self._lock:
+        jobs: List[Tuple[str, TopicState]] = []
+        with self._lock:  # no rospy call under it: the registrar makes and drops subscriptions
             for resolved in [r for r in self.topics if r not in wanted]:
                 state = self.topics.pop(resolved)
-                if state.subscriber is not None:
-                    state.subscriber.unregister()
+                state.gone = True
+                jobs.append(("unsubscribe", state))
             for resolved, name in wanted.items():
                 state = self.topics.get(resolved)
                 aliases = tuple(spellings[resolved][1:])
@@ -94,37 +123,116 @@ class TopicWatcher:
                 if state is None:
                     state = TopicState(name, resolved, users[name], aliases, used_as_value, stamp_only[name], needed)
                     self.topics[resolved] = state
-                    state.subscriber = rospy.Subscriber(resolved, rospy.AnyMsg, self._callback,
-                                                        callback_args=state, tcp_nodelay=True)
+                    jobs.append(("subscribe", state))
                 else:
                     state.spec_name, state.paths, state.aliases = name, users[name], aliases
                     state.scalar, state.implicit, state.needs = used_as_value, stamp_only[name], needed
-                    if state.cls is not None:
-                        state.errors = self._check(state)
+                    with self._types_lock:
+                        for kind in state.kinds.values():
+                            kind.problems = self._check(state, kind.cls, kind.type)
+                        if state.cls is not None:
+                            state.errors = self._check(state, state.cls, state.type)
+        if not jobs:
+            return
+        done = threading.Event()
+        for job in jobs:
+            self._jobs.put(job)
+        self._jobs.put(("done", done))  # type: ignore[arg-type]
+        self._start_registrar()
+        done.wait(wait)
 
-    def close(self) -> None:
+    def _start_registrar(self) -> None:
+        if self._registrar is None:
+            self._registrar = threading.Thread(target=self._register_loop, name="rubass-subscribe", daemon=True)
+            self._registrar.start()
+
+    def _register_loop(self) -> None:
+        """The registrar: every call that asks the master, one after the other."""
+        while True:
+            job = self._jobs.get()
+            if job is None:
+                return
+            kind, state = job
+            try:
+                if kind == "done":
+                    state.set()  # type: ignore[attr-defined]
+                elif kind == "subscribe":
+                    self._subscribe(state)
+                elif state.subscriber is not None:
+                    sub, state.subscriber = state.subscriber, None
+                    sub.unregister()
+            except Exception as exc:  # noqa: BLE001 - the registrar serves every later job
+                self.log("error", f"topic {state.resolved}: cannot {kind}: {exc.__class__.__name__}: {exc}")
+
+    def _subscribe(self, state: TopicState) -> None:
+        if state.gone or self._closed:
+            return
+        slow = threading.Timer(self.SLOW, lambda: self.log(
+            "warn", f"topic {state.resolved}: the master does not answer: its subscription is made when it does, "
+                    f"and the rules reading it stay unknown until then; every other rule is enforced meanwhile"))
+        slow.daemon = True
+        t0 = time.monotonic()
+        slow.start()
+        try:
+            sub = rospy.Subscriber(state.resolved, rospy.AnyMsg, self._callback, callback_args=state,
+                                   tcp_nodelay=True)
+        finally:
+            slow.cancel()
+        took = time.monotonic() - t0
         with self._lock:
-            for state in self.topics.values():
-                if state.subscriber is not None:
-                    state.subscriber.unregister()
+            keep = not state.gone and not self._closed
+            if keep:
+                state.subscriber = sub
+        if not keep:  # dropped by a reload (or closed) while it waited for the master
+            sub.unregister()
+        elif took > self.SLOW:
+            self.log("info", f"topic {state.resolved}: subscribed after {took:.1f} s (the master answers again)")
+
+    def close(self, wait: float = 1.0) -> None:
+        """Drop every subscription (by the registrar: a master that does not answer cannot hold
+        the caller for more than `wait` seconds)."""
+        with self._lock:
+            self._closed = True
+            states = list(self.topics.values())
             self.topics.clear()
+            for state in states:
+                state.gone = True
+        for state in states:
+            self._jobs.put(("unsubscribe", state))
+        self._jobs.put(None)
+        if self._registrar is None:
+            self._start_registrar()
+        assert self._registrar is not None
+        self._registrar.join(wait)
+
+    def _send(self, state: TopicState, now: float, msg: Any, wall: float, size: int) -> None:
+        """One message under every spelling of its topic, as one instant when the monitor can."""
+        if not state.aliases:
+            self.submit(state.spec_name, now, msg, wall, size)
+        elif self.submit_spellings is not None:
+            self.submit_spellings((state.spec_name,) + state.aliases, now, msg, wall, size)
+        else:
+            self.submit(state.spec_name, now, msg, wall, size)
+            for alias in state.aliases:  # the same message, under the spec's other spelling of the topic
+                self.submit(alias, now, msg, wall, 0)
 
     def _callback(self, raw: Any, state: TopicState) -> None:
         wall = time.time()
         now = wall if _rostime._rostime_current is None and _rostime._rostime_initialized else ros_now()
         state.messages += 1
+        if state.gone:
+            return  # a reload dropped the topic; its subscription goes soon
         if not state.paths:
-            self.submit(state.spec_name, now, None, wall, 0)  # age/frequency only: never deserialised
-            for alias in state.aliases:
-                self.submit(alias, now, None, wall, 0)
+            self._send(state, now, None, wall, 0)  # age/frequency only: never deserialised
             return
         header = getattr(raw, "_connection_header", None) or {}
-        md5 = header.get("md5sum", "")
-        if md5 != state.md5:
-            self._new_type(state, header)
+        if header.get("md5sum", "") != state.md5 or (state.mixed is not None and wall - state.checked >= RECHECK):
+            with self._types_lock:
+                evaluated = topictypes.admit(state, header, wall, self._new_kind, self.log)
+            if not evaluated:
+                return  # another type's message, while publishers of a type the spec can read are on
         if state.cls is None:
-            for name in (state.spec_name,) + state.aliases:
-                self.submit(name, now, UNKNOWN, wall, 0)
+            self._send(state, now, UNKNOWN, wall, 0)
             return
         try:
             msg = state.cls().deserialize(raw._buff)
@@ -136,31 +244,27 @@ class TopicWatcher:
         else:
             if state.errors and state.errors[-1].startswith("cannot deserialise"):
                 state.errors.pop()  # readable again: the error lasted until this message
-        self.submit(state.spec_name, now, msg, wall, len(raw._buff) if msg is not UNKNOWN else 0)
-        for alias in state.aliases:  # the same message, under the spec's other spelling of the topic
-            self.submit(alias, now, msg, wall, 0)
+        self._send(state, now, msg, wall, len(raw._buff) if msg is not UNKNOWN else 0)
 
-    def _new_type(self, state: TopicState, header: Dict[str, str]) -> None:
-        old = state.type
-        state.type, state.md5 = header.get("type", "?"), header.get("md5sum", "")
-        state.cls = self._class(state.type, state.md5, header.get("message_definition", ""))
-        state.errors = [] if state.cls is not None else [f"cannot load message type {state.type}"]
-        state.errors += self._check(state)  # what the rules cannot read first: the status shows the first
-        for e in state.errors:
+    def _new_kind(self, state: TopicState, header: Dict[str, str]) -> topictypes.Kind:
+        """A type not seen on this topic yet: its class, and what the rules cannot read in it (logged)."""
+        type_name, md5 = header.get("type", "?"), header.get("md5sum", "")
+        cls = self._class(type_name, md5, header.get("message_definition", ""))
+        kind = topictypes.Kind(type_name, md5, cls, self._check(state, cls, type_name))
+        for e in ([] if cls is not None else [f"cannot load message type {type_name}"]) + kind.problems:
             self.log("error", f"topic {state.resolved}: {e}")
-        if old and old != state.type:
-            self.log("error", f"topic {state.resolved} changed type from {old} to {state.type}")
-            state.errors.append(f"changed type from {old} to {state.type}")
+        return kind
 
-    def _check(self, state: TopicState) -> List[str]:
+    def _check(self, state: TopicState, cls: Any, type_name: str) -> List[str]:
+        """What the rules cannot read in messages of `cls` (a type_name) on this topic."""
         out = []
         for path, owners in state.paths.items():
             if path in state.implicit:
                 continue  # stamp_age() of a type without header.stamp is unknown (§11), no field error
-            problem = check_path(state.cls, path, path in state.scalar, state.needs.get(path)) \
-                if state.cls is not None else None
+            problem = check_path(cls, path, path in state.scalar, state.needs.get(path)) \
+                if cls is not None else None
             if problem:
-                out.append(f"{' and '.join(owners)} reads {state.spec_name}{ast.path_suffix(path)}, but in {state.type}: "
+                out.append(f"{' and '.join(owners)} reads {state.spec_name}{ast.path_suffix(path)}, but in {type_name}: "
                            f"{problem}; its value stays unknown")
         return out
 
@@ -185,8 +289,17 @@ class TopicWatcher:
         """What cannot be read as the spec needs now: a field missing or of the wrong kind, a
         message that cannot be deserialised, a type that cannot be loaded (not a mere type change)."""
         with self._lock:
-            return [f"topic {s.resolved}: {e}" for s in self.topics.values() for e in s.errors
-                    if not e.startswith("changed type")]
+            states = list(self.topics.values())
+        out = []
+        now = time.time()
+        for s in states:
+            if s.mixed is not None:
+                with self._types_lock:
+                    mixed = topictypes.refresh(s, now, self.log)
+                if mixed:
+                    out.append(f"topic {s.resolved}: {mixed}")
+            out += [f"topic {s.resolved}: {e}" for e in s.errors if not e.startswith("changed type")]
+        return out
 
     def status(self) -> List[TopicState]:
         with self._lock:
