@@ -419,13 +419,15 @@ class Engine:
                 self._take_ops(prev, node)
                 if node.key in src.rules:
                     dst.rules[node.key] = src.rules[node.key]
+            elif prev is not None and _same_ops(prev, node):  # edited: its `for`/`within`/`latch` keep
+                self._take_ops(prev, node)  # their history, so an edit that still holds releases nothing
         old_behaviours = {n.behaviour.identity: n for n in old._nodes if n.behaviour}
         for node in self._nodes:
             if not node.behaviour:
                 continue
             prev = old_behaviours.pop(node.behaviour.identity, None)
             if prev is not None:
-                if prev.behaviour.signature == node.behaviour.signature:  # type: ignore[union-attr]
+                if prev.behaviour.signature == node.behaviour.signature or _same_ops(prev, node):  # type: ignore[union-attr]
                     self._take_ops(prev, node)
                 node.active, node.value = prev.active, prev.value
                 if node.active:
@@ -543,6 +545,12 @@ _NO_FIELDS: FrozenSet[int] = frozenset()  # a tick, a deadline, a node sample: n
 
 def _release_last(e: Event) -> bool:
     return e.kind == "release"
+
+
+def _same_ops(a: _Node, b: _Node) -> bool:
+    """Whether an edited rule's stateful operators line up with its former ones (same kinds, same
+    order), so that their state can carry across a reload."""
+    return bool(a.compiled.ops) and [type(o) for o in a.compiled.ops] == [type(o) for o in b.compiled.ops]
 
 
 def _stamp(value: Any) -> Any:

@@ -108,6 +108,28 @@ def test_reload_keeps_unchanged_rules_timers_and_active_behaviours():
     assert [b.checked.index for b in new.orphans] == [2]  # old `if (a.q)` (stop) was active, is gone
 
 
+def test_an_edited_for_rule_keeps_its_history_so_an_active_stop_is_not_released():
+    """Acceptance finding: `fast: (topic /speed.data > 1) for 1 s` active, edited to `> 1.1` and
+    reloaded with the speed still 2.0: released at the reload and started again 1 s later (no stop
+    for 1.089 s). An edited rule's `for`/`within`/`latch` now keep their state when they line up."""
+    a = "entity a {{ rules: fast: (topic /speed.data > {}) for 1 s; }}\nfastb: if (a.fast) then {{ warn; }}\n"
+    old = build(a.format(1), 0.0)
+    old.evaluate_all(0.0)
+    old.on_message("/speed", 0.5, {"data": 2.0})
+    assert [e.kind for e in old.advance(1.5) if e.kind != "rule"] == ["start"]
+    new = build(a.format(1.1), 0.0)
+    assert [e.kind for e in new.adopt(old, 2.0) if e.kind != "rule"] == []  # still violated: nothing
+    assert new.active_behaviours() == [1]
+    assert [e.kind for e in new.on_message("/speed", 2.5, {"data": 2.0}) if e.kind != "rule"] == []
+    assert [e.kind for e in new.on_message("/speed", 3.0, {"data": 1.05}) if e.kind != "rule"] == ["release"]
+    # relaxed past the current value: the edit does not hold, the stop is released at the reload
+    again = build(a.format(3), 0.0)
+    new.on_message("/speed", 3.5, {"data": 2.0})
+    new.advance(4.6)
+    assert new.active_behaviours() == [1]
+    assert [e.kind for e in again.adopt(new, 5.0) if e.kind != "rule"] == ["release"]
+
+
 def test_reload_watches_new_topics_from_the_swap():
     old = build("entity a { rules: r: topic /x.data > 1; }\nif (a.r) then { warn; }\n", 0.0)
     new = build("entity a { rules: r: age(topic /z) > 1 s; }\nif (a.r) then { warn; }\n", 0.0)
