@@ -162,12 +162,18 @@ def build_matrix(ev: Evidence) -> None:
         for r in rules:
             users = [b for b in spec.behaviours if r.key in uses[b.index]]
             ids = list(rule_ids_of(spec, r))
-            ev.matrix.append(_row(h, r.key, [behaviour_label(spec, b.index) for b in users], ids, outcomes, not users))
+            row = _row(h, r.key, [behaviour_label(spec, b.index) for b in users], ids, outcomes, not users)
+            if outcomes and not any(r.key in o.rules_true for o in outcomes):
+                row.gaps.append("never true in any test")  # as the coverage's "rules never true"
+            ev.matrix.append(row)
         for b in direct_b:
             if any(r.key in uses[b.index] for r in rules):
                 continue  # shown with its rule
             ids = list(attrs(b).get("id", ()))
-            ev.matrix.append(_row(h, None, [behaviour_label(spec, b.index)], ids, outcomes, False))
+            row = _row(h, None, [behaviour_label(spec, b.index)], ids, outcomes, False)
+            if outcomes and not any(b.index in o.started for o in outcomes):
+                row.gaps.append("never started in any test")  # as the coverage's "behaviours never started"
+            ev.matrix.append(row)
     if outcomes:
         ev.coverage = coverage(spec, outcomes)
 

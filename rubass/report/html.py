@@ -110,7 +110,7 @@ def _matrix(ev: Evidence) -> str:
             "<code>covers</code>, as in the coverage below: a rule by its <code>@id</code> (its entity's when it has "
             "none; the hazard's when neither has one), and the hazard by its own id. A test that only makes a rule true "
             "covers nothing. Gaps are marked red: a hazard with no rule, a rule or hazard no test covers, a failing "
-            "test, a rule no behaviour acts on.</p>")
+            "test, a rule no behaviour acts on, a rule no test made true.</p>")
     return "<h2 id='matrix'>Hazard → rule → behaviour → test</h2>" + note + \
         _table(["hazard", "rule", "behaviours", "tests", "status"], rows)
 

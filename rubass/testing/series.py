@@ -51,6 +51,8 @@ def value(word: str, field_dim: Any = UNKNOWN, field: str = "the field") -> Any:
     number, unit = float(m.group(1)), m.group(2)
     if not unit:
         return number
+    if not (unit[0].isalpha() or unit[0] in "%\u00b0"):  # '1,5', '0.5.5': no unit, no number
+        raise SeriesError(f"'{word}' is not a value (a number, nan, inf, true, false or a quoted string)")
     known = field_dim is not UNKNOWN and field_dim is not None
     if unit not in UNITS:
         hint = f" (units of a {dimension_name(field_dim)}: {_units_of(field_dim)})" if known and _units_of(field_dim) \

@@ -387,3 +387,24 @@ def test_the_readme_figures_take_their_own_sections_date(tmp_path):
     path.write_text(one.replace("Figures of 2026-11-21, same machine.", "No date here."), encoding="utf-8")
     r = from_readme(str(path))
     assert r.figures() == "p50 0.358 ms, p99 1.979 ms, worst 4.1 ms" and "figures of" not in r.source
+
+
+def test_a_named_rule_never_true_is_a_gap_as_in_the_coverage(write, tmp_path, capsys):
+    write("lib.yaml", LIB)
+    spec = write("robot.rbs", SPEC)
+    tests = write("robot.test.yaml", REPORT_TESTS.replace("covers: [SR-1]", "covers: [SR-1, H1, SR-3, H3]"))
+    out = str(tmp_path / "r.html")
+    assert main(["report", spec, "--tests", tests, "-o", out]) == 0
+    html = open(out, encoding="utf-8").read()
+    h3 = re.search(r"<tr><td><b>H3</b>.*?</tr>", html, re.S).group(0)  # named, but /cmd_vel never came
+    assert "overspeed stops" in h3 and "never true in any test" in h3 and "covered" not in h3
+    coverage = html.split("<h3>Coverage over all tests</h3>", 1)[1]
+    assert re.search(r"rules never true</th><td class='gap'>[^<]*base.turning", coverage)
+
+
+def test_a_word_that_is_no_number_is_no_value():
+    from rubass.testing.series import SeriesError, expand
+
+    for word in ("1,5", "0.5.5", "abc"):
+        with pytest.raises(SeriesError, match=f"'{re.escape(word)}' is not a value"):
+            expand(word)
