@@ -231,6 +231,10 @@ class _Reader:
             cls = message_class(t["type"], self.registry)
         except MessageError as exc:
             raise self.fail(t.at("type"), str(exc)) from None
+        before = case.topics.get(topic)
+        if before is not None and before.type_name != t["type"]:  # `odom:` beside `/odom:`: one topic
+            raise self.fail(t.at("type"), f"topic {topic} is {before.type_name} at line {before.line}: one topic "
+                                          f"has one type")
         case.topics[topic] = TopicInput(topic, t["type"], cls, line)
         series = [k for k in ("field", "fields", "values", "rate") if k in t]
         if series:

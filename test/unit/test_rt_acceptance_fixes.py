@@ -408,3 +408,24 @@ def test_a_word_that_is_no_number_is_no_value():
     for word in ("1,5", "0.5.5", "abc"):
         with pytest.raises(SeriesError, match=f"'{re.escape(word)}' is not a value"):
             expand(word)
+
+
+def test_two_spellings_of_one_topic_are_one_topic(files, capsys):
+    path = files("""  - name: two series of one topic
+    duration: 3 s
+    topics:
+      /cmd_vel: {type: geometry_msgs/Twist, rate: 10 Hz, field: linear.x, values: "0x30"}
+      cmd_vel: {type: geometry_msgs/Twist, rate: 10 Hz, field: angular.z, values: "0x10 2x20"}
+    expect:
+      - {at: 1 s, start: spin}
+""")
+    code, out, err = run(capsys, path)
+    assert code == 0, out + err
+    path = files("""  - name: two types
+    topics:
+      /cmd_vel: {type: geometry_msgs/Twist, rate: 10 Hz, field: linear.x, values: "0x30"}
+      cmd_vel: {type: nav_msgs/Odometry, rate: 10 Hz, field: twist.twist.linear.x, values: "0x30"}
+""")
+    code, out, err = run(capsys, path)
+    assert code == 2 and f"{path}:{line_of(path, 'cmd_vel: {type: nav')}: error: topic /cmd_vel is " \
+                         f"geometry_msgs/Twist at line {line_of(path, '/cmd_vel:')}" in err
