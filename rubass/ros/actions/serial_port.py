@@ -31,6 +31,7 @@ class SerialPlugin(ActionPlugin):
         self.lock = threading.Lock()
         self.state = "closed"
         self.next_open = 0.0  # monotonic: a hold reopens the port no sooner (after a failed attempt)
+        self.call_timeout = 2 * float(self.params.get("write_timeout") or 0.0)  # write, flush: the runner's stuck bound
 
     def setup(self) -> None:
         self._open()  # a board that is not there yet is not fatal: periodic() keeps trying
