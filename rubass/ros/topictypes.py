@@ -109,6 +109,8 @@ def refresh(state: Any, now: float, log: Log) -> Optional[str]:
     if len(present) <= 1:
         log("info", f"topic {state.resolved}: publishers of one type at most are left: its data error is over")
         state.mixed = None
+        if present and present[0].md5 != state.md5:  # the one left is what is read now (its errors at once)
+            adopt(state, present[0], log, change=True)
         for m in [m for m in state.kinds if m != state.md5]:
             del state.kinds[m]
         return None
