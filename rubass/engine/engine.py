@@ -12,6 +12,7 @@ from __future__ import annotations
 import heapq
 import itertools
 import math
+import sys
 from dataclasses import dataclass
 from typing import AbstractSet, Any, Dict, FrozenSet, Iterable, List, Optional, Set, Tuple
 
@@ -575,4 +576,8 @@ def _laser_limits(msg: Any) -> Optional[Tuple[float, float]]:
         lo, hi = extract(msg, ("range_min",)), extract(msg, ("range_max",))
     except FieldError:
         return None
-    return (lo, hi) if type(lo) is float and type(hi) is float else None
+    # limits a driver left unset (0 and 0, NaN, inf) would make every reading invalid, the sector
+    # unknown and its stop released: such a bound is ignored (readings count from 0 m, finite ones)
+    lo = lo if type(lo) is float and math.isfinite(lo) and lo >= 0.0 else 0.0
+    hi = hi if type(hi) is float and math.isfinite(hi) and hi > lo else sys.float_info.max
+    return lo, hi

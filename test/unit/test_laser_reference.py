@@ -21,3 +21,18 @@ def reference(pick, ranges, lo, hi):
 def test_sector_min_and_max_follow_rep_117(ranges, lo, hi, use_max):
     pick = max if use_max else min
     assert _laser(pick, tuple(ranges), (lo, hi)) == reference(pick, ranges, lo, hi)
+
+
+def test_limits_a_driver_left_unset_are_ignored_not_a_blind_scan():
+    """Acceptance finding: range_min = range_max = 0 (left unset by a driver) made every reading
+    invalid, `min(ranges) < 0.5 m` unknown, and the stop released. Such bounds are ignored now;
+    NaN and +inf readings stay no reading, -inf stays 0 m."""
+
+    from rubass.engine.engine import _laser_limits
+
+    ranges = (2.0, 0.3, math.nan, math.inf)
+    for lo, hi in ((0.0, 0.0), (math.nan, math.nan), (0.1, math.inf), (0.5, 0.2), (-1.0, 30.0)):
+        lim = _laser_limits({"range_min": lo, "range_max": hi})
+        assert _laser(min, ranges, lim) == (0.3 if lo != 0.5 else 2.0), (lo, hi, lim)
+        assert _laser(max, ranges, lim) == 2.0, (lo, hi, lim)
+    assert _laser_limits({"range_min": 0.1, "range_max": 10.0}) == (0.1, 10.0)  # real limits kept
