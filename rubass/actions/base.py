@@ -3,17 +3,14 @@ then driven through start / hold / release by its own runner thread."""
 from __future__ import annotations
 
 import importlib
-import importlib.util
 import inspect
 import linecache
-import os
-import sys
-import sysconfig
 from dataclasses import dataclass, field
 from typing import Any, Dict, List, Optional, Tuple
 
 from ..lang.errors import Diagnostic
 from ..lang.library import ActionDef
+from ..lang.stdlib import is_standard_library
 
 
 class ActionSetupError(Exception):
@@ -106,7 +103,7 @@ class CustomPlugin(ActionPlugin):
     def __init__(self, action: ActionDef) -> None:
         super().__init__(action)
         module_name, _, class_name = action.plugin.partition(":")
-        if _is_standard_library(module_name):
+        if is_standard_library(module_name):
             # a library must not reach code that runs commands ('subprocess:Popen', 'os:system',
             # 'antigravity:…' opens a browser on import): plugins are the robot's own packages
             raise self._error(f"plugin module '{module_name}' is part of Python's standard library; a custom "
@@ -185,24 +182,6 @@ def make_plugin(action: ActionDef) -> ActionPlugin:
         return CustomPlugin(action)
     module, _, cls = BUILTIN[action.plugin].partition(":")
     return getattr(importlib.import_module(module), cls)(action)  # type: ignore[no-any-return]
-
-
-def _is_standard_library(module_name: str) -> bool:
-    """Whether the top-level package is Python's own (found without importing it)."""
-    top = module_name.split(".")[0]
-    names = getattr(sys, "stdlib_module_names", None)  # Python 3.10+
-    if names is not None:
-        return top in names
-    if top in sys.builtin_module_names:
-        return True
-    try:
-        spec = importlib.util.find_spec(top)
-    except (ImportError, ValueError):
-        return False
-    origin = getattr(spec, "origin", None) or ""
-    stdlib = os.path.realpath(sysconfig.get_paths()["stdlib"])
-    path = os.path.realpath(origin)
-    return path.startswith(stdlib + os.sep) and "-packages" not in path
 
 
 def describe(ctx: Context) -> str:
