@@ -271,6 +271,9 @@ class ActionRunner:
                 self.log("error", f"action '{self.plugin.name}' {what} failed ({self.stats.failures} failures so "
                                   f"far; retrying): {exc.__class__.__name__}: {exc}")
             return False
+        except BaseException:  # SystemExit from a plugin: not a call still in progress
+            self._returned()
+            raise
         self._returned()
         if what != "periodic":
             self.stats.calls += 1

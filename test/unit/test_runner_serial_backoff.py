@@ -84,9 +84,9 @@ def test_holds_while_the_board_is_away_reopen_at_the_documented_period_not_every
             r.submit("hold", CTX)
             time.sleep(0.02)
         away = [t for t in opens if t >= t0]
-        # periodic() every 0.5 s, and a hold only once 0.5 s have passed since a failed attempt:
-        # at most two per period (it was one per hold, ~100)
-        assert 2 <= len(away) <= 10, len(away)
+        # a hold once right after the write failed, then periodic() every 0.5 s (it was one per hold, ~100)
+        assert 2 <= len(away) <= 7, len(away)
+        # the failed write, then periodic()'s "is away while the action is active" every 0.5 s
         assert r.stats.failures - failures0 <= 7, r.stats.failures - failures0
         assert r.stats.failing, "the board that holds the stop is away: the action is failing"
         board.plug()

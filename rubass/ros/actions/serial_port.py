@@ -1,11 +1,10 @@
 """The `serial` plugin (pyserial): bytes on start, hold and release; the port is reopened after
-the device vanishes (at most every 0.5 s after a failed attempt), and while the action is active its
-start is written again on every reopen (a board that was away lost its state, whether or not it had
-the start before)."""
+the device vanishes (every 0.5 s while it stays away, not on every hold), and while the action is
+active its start is written again on every reopen (a board that was away lost its state, whether
+or not it had the start before)."""
 from __future__ import annotations
 
 import threading
-import time
 from typing import Any, Optional
 
 import rospy
@@ -30,7 +29,7 @@ class SerialPlugin(ActionPlugin):
         self.started = False  # the start bytes reached the port open now (reset when it closes)
         self.lock = threading.Lock()
         self.state = "closed"
-        self.next_open = 0.0  # monotonic: a hold reopens the port no sooner (after a failed attempt)
+        self.open_failed = False  # the latest attempt to open the port failed (then only periodic() retries)
         self.call_timeout = 2 * float(self.params.get("write_timeout") or 0.0)  # write, flush: the runner's stuck bound
 
     def setup(self) -> None:
@@ -42,12 +41,12 @@ class SerialPlugin(ActionPlugin):
                                               write_timeout=self.params["write_timeout"])
             self.state = "open"
             self.started = False  # a new connection: the device knows nothing of earlier writes
-            self.next_open = 0.0
+            self.open_failed = False
             return True
         except (serial.SerialException, OSError, ValueError) as exc:
             self.port = None
             self.state = f"cannot open {self.params['port']}: {exc}"
-            self.next_open = time.monotonic() + REOPEN_PERIOD
+            self.open_failed = True
             return False
 
     def _write(self, data: Optional[bytes]) -> None:
@@ -82,10 +81,11 @@ class SerialPlugin(ActionPlugin):
         self.started = self.port is not None
 
     def hold(self, ctx: Context) -> None:
-        """A hold (every tick) reopens a vanished port at most every REOPEN_PERIOD, like periodic(), and
-        counts no failure while the board is away: periodic() reports that (twice a second)."""
+        """A hold (every tick) reopens a vanished port once, at once (a glitch: the board is back before
+        periodic() would look); after a failed attempt only periodic() reopens it, every REOPEN_PERIOD,
+        and holds count no failure while the board is away: periodic() reports that (twice a second)."""
         with self.lock:
-            if self.port is None and (time.monotonic() < self.next_open or not self._open()):
+            if self.port is None and (self.open_failed or not self._open()):
                 raise Skipped(f"serial board {self.params['port']} is away ({self.state})")
         self._catch_up()  # a hold may reopen the port before periodic() does: the start first
         self._write(_bytes(self.params.get("on_hold")))
