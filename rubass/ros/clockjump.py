@@ -139,3 +139,46 @@ def _carried(b: Any) -> str:
 
 def _latched(b: Any) -> str:
     return f"{b.label} (latched before a clock jump)"
+
+
+class ClockStall:
+    """With use_sim_time, the /clock stopping (a paused simulator, a bag at its end, a dead
+    simulator) stops ROS time: no `for` or `age` can advance, and no tick or ~heartbeat comes
+    (the watchdog acts). Said once (then at most every LOG_EVERY s) after AFTER s of wall time
+    without ROS time moving, and again when it moves. `check` is cheap: the watcher's thread
+    calls it a few times a second, and the status asks `stalled` (computed live, so the first
+    look after the clock moves again sees it moving)."""
+
+    AFTER = 2.0  # s of wall time without ROS time moving
+    LOG_EVERY = 10.0
+
+    def __init__(self, now: Callable[[], float], wall: Callable[[], float], log: Log) -> None:
+        self.now, self.wall, self.log = now, wall, log
+        self._ros = now()
+        self._since = wall()  # wall time ROS time last moved
+        self._said = False
+        self._logged = float("-inf")
+
+    def stalled(self) -> str:
+        """'' while ROS time moves; otherwise what to say (for /diagnostics)."""
+        ros, wall = self.now(), self.wall()
+        if ros != self._ros:
+            self._ros, self._since = ros, wall
+            return ""
+        still = wall - self._since
+        if still < self.AFTER:
+            return ""
+        return (f"no /clock for {still:.1f} s (use_sim_time): ROS time stands still at {ros:.3f} s, "
+                f"`for` and `age` cannot advance and no ~heartbeat is published until it moves")
+
+    def check(self) -> None:
+        was = self._since
+        text = self.stalled()
+        if text and not self._said and self.wall() - self._logged >= self.LOG_EVERY:
+            self._said = True  # this stall is logged (and its end will be)
+            self._logged = self.wall()
+            self.log("warn", text)
+        elif not text and self._said and self._since != was:
+            self._said = False
+            self.log("info", f"/clock moves again (ROS time {self._ros:.3f} s) after {self.wall() - was:.1f} s "
+                             f"standing still")

@@ -21,6 +21,7 @@ from ..lang import ast
 from ..lang.fielduse import field_needs
 from ..lang.model import CheckedSpec
 from . import topictypes
+from .clockjump import ClockStall
 from .msgtypes import check_path
 from .topictypes import RECHECK
 
@@ -86,6 +87,7 @@ class TopicWatcher:
         self._jobs: "queue.Queue[Optional[Tuple[str, TopicState]]]" = queue.Queue()
         self._registrar: Optional[threading.Thread] = None
         self._closed = False
+        self.clock: Optional[ClockStall] = None  # with use_sim_time: says when /clock stops
 
     def sync(self, spec: CheckedSpec, wait: float = 1.0) -> None:
         """Subscribe to the spec's topics, unsubscribe from those it no longer names. Returns once
@@ -132,6 +134,9 @@ class TopicWatcher:
                             kind.problems = self._check(state, kind.cls, kind.type)
                         if state.cls is not None:
                             state.errors = self._check(state, state.cls, state.type)
+        if self.clock is None and not _rostime.is_wallclock() and _rostime._rostime_initialized:
+            self.clock = ClockStall(ros_now, time.time, self.log)
+            threading.Thread(target=self._watch_clock, name="rubass-clock", daemon=True).start()
         if not jobs:
             return
         done = threading.Event()
@@ -163,6 +168,14 @@ class TopicWatcher:
                     sub.unregister()
             except Exception as exc:  # noqa: BLE001 - the registrar serves every later job
                 self.log("error", f"topic {state.resolved}: cannot {kind}: {exc.__class__.__name__}: {exc}")
+
+    def _watch_clock(self) -> None:
+        while not self._closed:
+            try:
+                self.clock.check()  # type: ignore[union-attr]
+            except Exception as exc:  # noqa: BLE001 - a log line lost, never the watch
+                self.log("debug", f"clock watch: {exc.__class__.__name__}: {exc}")
+            time.sleep(0.25)
 
     def _subscribe(self, state: TopicState) -> None:
         if state.gone or self._closed:
@@ -287,7 +300,9 @@ class TopicWatcher:
 
     def data_errors(self) -> List[str]:
         """What cannot be read as the spec needs now: a field missing or of the wrong kind, a
-        message that cannot be deserialised, a type that cannot be loaded (not a mere type change)."""
+        message that cannot be deserialised, a type that cannot be loaded (not a mere type change),
+        publishers of two types at once; and, with use_sim_time, a /clock that stopped (no tick
+        runs ~error_actions then: it is for /diagnostics, which the main thread publishes)."""
         with self._lock:
             states = list(self.topics.values())
         out = []
@@ -299,7 +314,8 @@ class TopicWatcher:
                 if mixed:
                     out.append(f"topic {s.resolved}: {mixed}")
             out += [f"topic {s.resolved}: {e}" for e in s.errors if not e.startswith("changed type")]
-        return out
+        stall = self.clock.stalled() if self.clock is not None else ""
+        return out + ([f"topic /clock: {stall}"] if stall else [])
 
     def status(self) -> List[TopicState]:
         with self._lock:
