@@ -11,12 +11,13 @@ evaluated: a real violation in them is still stopped, the other type's messages 
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, field
-from typing import Any, Callable, Dict, List, Optional, Set
+from dataclasses import dataclass
+from typing import Any, Callable, Dict, List, Optional, Set, Tuple
 
 WINDOW = 1.0  # s: without a readable connection list, a publisher is present while it sent within this
 RECHECK = 0.25  # s: while two types publish, how often a message of the current type looks again
 LOG_EVERY = 10.0  # s: a conflict that ends and starts again is logged at most this often per topic
+MAX_CALLERS = 32  # publishers remembered per topic beyond those that sent within WINDOW
 
 Log = Callable[[str, str], None]
 
@@ -30,14 +31,13 @@ class Kind:
     cls: Any  # None: the type cannot be loaded
     problems: List[str]  # what the spec's fields cannot read in this type
     last: float = 0.0  # wall time of its newest message
-    callers: Set[str] = field(default_factory=set)  # the publishers (caller ids) seen sending it
 
     @property
     def fits(self) -> bool:
         return self.cls is not None and not self.problems
 
-    def label(self) -> str:
-        who = ", ".join(sorted(c for c in self.callers if c))
+    def label(self, callers: Dict[str, Tuple[str, float]]) -> str:
+        who = ", ".join(sorted(c for c, (md5, _) in callers.items() if c and md5 == self.md5))
         return f"{self.type} (from {who})" if who else self.type
 
 
@@ -51,9 +51,9 @@ def present_md5s(subscriber: Any, callers: Dict[str, Any], now: float) -> Set[st
     return {md5 for md5, last in callers.values() if now - last <= WINDOW}
 
 
-def conflict_text(present: List[Kind]) -> str:
+def conflict_text(present: List[Kind], callers: Dict[str, Tuple[str, float]]) -> str:
     fitting = [k.type for k in present if k.fits]
-    labels = " and ".join(k.label() for k in sorted(present, key=lambda k: k.type))
+    labels = " and ".join(k.label(callers) for k in sorted(present, key=lambda k: k.type))
     read = (f"only its {' and '.join(fitting)} messages are evaluated" if fitting else
             "the spec's fields fit none of them: its values are unknown")
     return f"publishers of {len(present)} types at once: {labels}; {read}"
@@ -70,23 +70,23 @@ def admit(state: Any, header: Dict[str, str], now: float, new_kind: Callable[[An
         kind = state.kinds[md5] = new_kind(state, header)
     kind.last = now
     caller = header.get("callerid", "")
-    kind.callers.add(caller)
     state.callers[caller] = (md5, now)
+    if len(state.callers) > MAX_CALLERS:  # anonymous publishers come and go: keep the recent ones
+        state.callers = {c: v for c, v in state.callers.items() if now - v[1] <= WINDOW or c == caller}
     state.checked = now
     live = present_md5s(state.subscriber, state.callers, now) | {md5}
     present = [k for k in state.kinds.values() if k.md5 in live]
     if len(present) <= 1:
         if state.mixed is not None:
-            log("info", f"topic {state.resolved}: only {kind.type} is published again: its data error is over")
+            log("info", over(state, kind.type))
             state.mixed = None
         for m in [m for m in state.kinds if m != md5]:
             del state.kinds[m]  # gone: if it comes back, it is a change again
         state.callers = {c: v for c, v in state.callers.items() if v[0] == md5}
-        kind.callers = {c for c in kind.callers if c in state.callers}
         if md5 != state.md5:
             adopt(state, kind, log, change=True)
         return True
-    text = conflict_text(present)
+    text = conflict_text(present, state.callers)
     if state.mixed != text:
         if state.mixed is None and now - state.mixed_logged >= LOG_EVERY:
             state.mixed_logged = now
@@ -107,15 +107,20 @@ def refresh(state: Any, now: float, log: Log) -> Optional[str]:
     live = present_md5s(state.subscriber, state.callers, now)
     present = [k for k in state.kinds.values() if k.md5 in live]
     if len(present) <= 1:
-        log("info", f"topic {state.resolved}: publishers of one type at most are left: its data error is over")
+        log("info", over(state, present[0].type if present else ""))
         state.mixed = None
         if present and present[0].md5 != state.md5:  # the one left is what is read now (its errors at once)
             adopt(state, present[0], log, change=True)
         for m in [m for m in state.kinds if m != state.md5]:
             del state.kinds[m]
         return None
-    state.mixed = conflict_text(present)
+    state.mixed = conflict_text(present, state.callers)
     return state.mixed
+
+
+def over(state: Any, left: str) -> str:
+    return (f"topic {state.resolved}: {f'only {left} is published now' if left else 'no publisher is left'}: "
+            f"its data error of two types at once is over")
 
 
 def adopt(state: Any, kind: Kind, log: Log, change: bool) -> None:

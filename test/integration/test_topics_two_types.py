@@ -49,8 +49,9 @@ def test_two_types_on_one_topic_are_one_held_data_error_and_a_real_violation_sti
     text = monitor[-1]["message"]
     assert "/speed" in text and "std_msgs/String" in text and "std_msgs/Float64" in text, text
     # the Float64 publisher gone (the probe ended): the conflict is over, the String alone is its own error
-    wait_log(mon, ros, "topic /speed: publishers of one type at most are left: its data error is over", timeout=5)
-    log = ros.log(mon).split("publishers of one type at most are left")[0]
+    wait_log(mon, ros, "topic /speed: only std_msgs/String is published now: its data error of two types at once "
+                       "is over", timeout=5)
+    log = ros.log(mon).split("only std_msgs/String is published now")[0]
     assert log.count("publishers of 2 types at once") == 1 and "changed type" not in log, log
     assert log.count("running brake (~error_actions)") == 1 and "the data error is gone" not in log, log
     strings.kill()
