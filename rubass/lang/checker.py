@@ -20,7 +20,7 @@ from .deporder import dependency_order
 from .model import BoundAction, CheckedBehaviour, CheckedRule, CheckedSpec, TopicUse, Value
 from .paths import PathError, resolve
 from .source import SourceSet, Span
-from .typecheck import ANY, ExprChecker, Resolution, Scope, Ty
+from .typecheck import ANY, ExprChecker, Resolution, Scope, Ty, _constant
 
 STAMP_PATH: Tuple[ast.PathElem, ...] = ("header", "stamp")
 UNUSED_ACTION = "unused action "  # the subject of that warning, then the action's name
@@ -153,7 +153,9 @@ class _Checker:
         if not isinstance(out, ast.Lit):
             if not any(d.span.start >= decl.span.start and d.span.file == decl.span.file and
                        d.span.start <= decl.span.end for d in self.diags):
-                self.error(decl.expr.span, f"constant '{name}' must be computable before the monitor starts")
+                self.error(decl.expr.span, f"constant '{name}' must be computable before the monitor starts"
+                                           + (" (it has no value: a division by zero, the square root of a negative "
+                                              "number, …)" if _constant(out) else ""))
             out = ast.Lit(0.0)
         self.const_values[name] = (out, ty)
         return out, ty

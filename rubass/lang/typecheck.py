@@ -107,7 +107,17 @@ class ExprChecker(BuiltinChecks):
         if method is None:
             method = getattr(type(self), "_" + type(expr).__name__.lower())  # _binary for Binary
             self._methods[type(expr)] = method
-        return method(self, expr)  # type: ignore[no-any-return]
+        out, ty = method(self, expr)
+        if type(out) is ast.Lit:
+            if type(out.value) is float and not math.isfinite(out.value) and type(expr) is not ast.Num:
+                self.error(expr.span, "this constant expression overflows to infinity: a limit of infinity "
+                                      "would never trip (to say 'no limit', leave the rule out)")
+                out = ast.Lit(0.0, span=out.span)  # reported once, not again by what uses it
+        elif _literal_operands(out) and not any(w.span == expr.span for w in self.warnings):
+            # _fold left it: unknown whatever the robot does, as at run time (issue 20.1), but said
+            self.warn(expr.span, "this constant expression has no value (a division by zero, the square root "
+                                 "of a negative number, …): it is unknown, and so is what uses it")
+        return out, ty
 
     # -- leaves --------------------------------------------------------------------------
     def _num(self, e: ast.Num) -> Tuple[ast.Expr, Ty]:
@@ -384,6 +394,17 @@ def _ty_of_value(v: Value) -> Ty:
 def _constant(e: ast.Expr) -> bool:
     """No topic, node, rule or time in it: its value is known before the monitor starts."""
     return all(isinstance(x, (ast.Lit, ast.Unary, ast.Binary, ast.Call, ast.Num)) for x in ast.walk(e))
+
+
+def _literal_operands(e: ast.Expr) -> bool:
+    """An operation on literals only, which _fold could not fold."""
+    if isinstance(e, ast.Unary):
+        return isinstance(e.operand, ast.Lit)
+    if isinstance(e, ast.Binary):
+        return isinstance(e.left, ast.Lit) and isinstance(e.right, ast.Lit)
+    if isinstance(e, ast.Call):
+        return e.func in SCALAR_FUNCTIONS and bool(e.args) and all(isinstance(a, ast.Lit) for a in e.args)
+    return False
 
 
 def _fold(e: ast.Expr) -> ast.Expr:
