@@ -172,7 +172,11 @@ class _Checker:
                 uses = self.active_uses.setdefault(key, set())
                 scope = Scope(self.resolver(ent.name.name, key), nodes=nodes, entity=ent.name.name,
                               actions=self.declared_names, active_uses=uses, model=self.model)
-                checked[key] = ExprChecker(scope, self.diags, self.warnings).condition(r.expr, f"rule '{r.name.name}'")
+                try:
+                    checked[key] = ExprChecker(scope, self.diags, self.warnings).condition(r.expr, f"rule '{r.name.name}'")
+                except RecursionError:  # at the expression, not at 1:1 (issue 20.5)
+                    self.error(r.name.span, TOO_DEEP)
+                    checked[key] = ast.Lit(False, span=r.expr.span)
         return checked
 
     def order(self) -> List[str]:
@@ -289,7 +293,11 @@ class _Checker:
             uses = self.active_uses.setdefault(f"b:{index}", set())
             user = f"b:{index}"
             scope = Scope(self.resolver(None, user), actions=self.declared_names, active_uses=uses, model=self.model)
-            cond = ExprChecker(scope, self.diags, self.warnings).condition(d.cond, "the condition of 'if'")
+            try:
+                cond = ExprChecker(scope, self.diags, self.warnings).condition(d.cond, "the condition of 'if'")
+            except RecursionError:
+                self.error(d.span, TOO_DEEP)
+                cond = ast.Lit(False, span=d.cond.span)
             bound: List[BoundAction] = []
             for call in d.actions:
                 name = call.name.name
@@ -342,6 +350,10 @@ def check(spec: ast.Spec, sources: SourceSet, extra_libraries: Sequence[str] = (
     None, errors, warnings)."""
     with gc_paused():
         return _check(spec, sources, extra_libraries, model)
+
+
+TOO_DEEP = ("this expression is nested too deeply to check: a sum or product of a few hundred terms, or as "
+            "many nested parentheses; split it into several rules (an 'and'/'or' chain may be of any length)")
 
 
 def _check(spec: ast.Spec, sources: SourceSet, extra_libraries: Sequence[str],

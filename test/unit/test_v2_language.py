@@ -212,6 +212,16 @@ def test_deep_nesting_is_reported_at_the_expression(tmp_path):  # issue 20.5
     assert got[0][0] == 4 and got[0][1] > 10 and "nested too deeply" in got[0][2] and "150" in got[0][2], got
 
 
+@pytest.mark.parametrize("op", ["+", "*"])
+def test_a_very_long_sum_or_product_is_reported_at_its_rule(tmp_path, op):  # issue 20.5, acceptance finding
+    """Not at 1:1 with the file's first line under the caret: at the rule (or behaviour) it is in."""
+    terms = f" {op} ".join("topic /a.b" for _ in range(600))
+    got = errors(tmp_path, HEAD + f"entity e {{\n  rules:\n    ok: topic /a.b > 1;\n    r: {terms} > 1;\n}}\n"
+                                  f"if (e.ok) then {{ stop; }}\nif ({terms} > 2) then {{ stop; }}\n")
+    assert [(line, col) for line, col, _ in got] == [(6, 5), (9, 1)], got
+    assert all("nested too deeply to check" in msg and "split it into several rules" in msg for _, _, msg in got)
+
+
 @pytest.mark.parametrize("data,col,mark", [(b"entity e { rules: r: topic /a.b > 1; } // caf\xe9\n", 46, "\ufffd"),
                                           (b"entity e { rules: r: topic /a.b\x00 > 1; }\n", 32, "\u2400")])
 def test_unreadable_bytes_are_shown_with_their_line_and_caret(tmp_path, data, col, mark):  # issue 20.7
