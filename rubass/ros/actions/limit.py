@@ -1,6 +1,6 @@
 """The `limit` plugin (LANGUAGE.md §16): while active, every velocity command on `input` is
-republished on `topic` with the named axes clamped; no command for `timeout` means zero, at
-`rate`; while inactive, nothing.
+republished on `topic` with the named axes clamped, and the latest one again at `rate` when the
+input is slower; no command for `timeout` means zero, at `rate`; while inactive, nothing.
 
 The input is read from set-up on (rospy.AnyMsg, tcp_nodelay), so the first command after a
 start is not lost to connection set-up and a start can republish the latest command at once.
@@ -42,6 +42,7 @@ class LimitPlugin(ActionPlugin):
         self._raw: Optional[bytes] = None  # the latest command, as it came
         self._raw_at = float("-inf")  # its arrival (time.monotonic())
         self._due = False  # publish at the next periodic although a command is fresh (handed the topic)
+        self._pub_at = float("-inf")  # this action's latest publication (time.monotonic())
         self._last_log = float("-inf")
         self.input_errors = 0
         self.pub: Optional[rospy.Publisher] = None
@@ -102,9 +103,12 @@ class LimitPlugin(ActionPlugin):
         with self._lock:
             if not self._on:
                 return
-            if self._due or time.monotonic() - self._raw_at > self.timeout:
+            now = time.monotonic()
+            if self._due or now - self._raw_at > self.timeout or now - self._pub_at >= 0.9 * self.period:
                 # no command for `timeout` is no command to keep moving: zero, at `rate`. Just
-                # handed the topic: the latest command if still fresh (else zero), heard at once
+                # handed the topic: the latest command if still fresh (else zero), heard at once.
+                # A planner slower than `rate`: its latest command again, so that the output keeps
+                # a mux's input alive (twist_mux drops an input silent for its timeout)
                 self._publish(self._current())
                 self._due = False
 
@@ -163,6 +167,7 @@ class LimitPlugin(ActionPlugin):
             if not mine or self.pub is None:
                 return -1
             self.pub.publish(msg)
+            self._pub_at = time.monotonic()
             return self.pub.get_num_connections()
 
     def _input_ok(self) -> None:
