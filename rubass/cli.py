@@ -7,6 +7,7 @@ import sys
 from typing import List, Optional, Sequence
 
 from .lang import SpecError, format_spec, load_spec, parse_source
+from .lang.topicnames import spellings
 from .replay.command import register as register_replay
 from .testing.command import register as register_test
 from .report.command import register as register_report
@@ -49,7 +50,7 @@ def cmd_check(args: argparse.Namespace) -> int:
             continue
         if not args.quiet:
             print(f"{path}: ok ({len(checked.rules)} rules, {len(checked.behaviours)} behaviours, "
-                  f"{len(checked.topics)} topics, {len(checked.nodes)} nodes, {len(checked.actions)} actions)")
+                  f"{len(spellings(checked.topics))} topics, {len(checked.nodes)} nodes, {len(checked.actions)} actions)")
     return status
 
 

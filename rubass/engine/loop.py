@@ -26,6 +26,7 @@ class Message:
     msg: Any = None
     received: float = 0.0  # wall-clock arrival, to measure reaction latency
     size: int = 0  # serialised bytes, counted against the queue's byte budget
+    also: Tuple[str, ...] = ()  # the topic's other spellings in the spec: the same message, one instant
 
 
 @dataclass(frozen=True)
@@ -295,7 +296,7 @@ class EngineLoop:
             items, self._newest = sorted(self._newest.values(), key=lambda m: m.time), {}
         for m in items:
             self._applied[m.topic] = m.time
-            self._emit(self.engine.on_message(m.topic, m.time, m.msg), m)
+            self._emit(self._on_message(m), m)
 
     def _handle(self, item: Any, queued: bool = True) -> None:
         if self.clock_jumps and isinstance(item, (Message, NodeSample)) and \
@@ -306,7 +307,7 @@ class EngineLoop:
                 self._unqueue(item.size)
             if self._applied and item.time <= self._applied.get(item.topic, float("-inf")):
                 return  # older than a newer message of its topic already handled (conflated)
-            self._emit(self.engine.on_message(item.topic, item.time, item.msg), item)
+            self._emit(self._on_message(item), item)
         elif isinstance(item, NodeSample):
             self._emit(self.engine.on_node_sample(item.node, item.time, item.alive, item.cpu, item.memory), item)
         elif isinstance(item, Call):
@@ -314,6 +315,11 @@ class EngineLoop:
                 item.done.put((True, item.fn(self.engine)))
             except Exception as exc:  # handed back to the caller's thread
                 item.done.put((False, exc))
+
+    def _on_message(self, m: Message) -> List[Event]:
+        if m.also:  # every spelling of the topic at one instant: one evaluation after all of them
+            return self.engine.on_messages(m.time, tuple((t, m.msg) for t in (m.topic,) + m.also))
+        return self.engine.on_message(m.topic, m.time, m.msg)
 
     def _emit(self, events: List[Event], cause: Any) -> None:
         if events:

@@ -246,14 +246,14 @@ class Monitor(Reloading):
             self._on_events(hold(latch.actions, f"restored: {latch.holder}", now), "reload")
         self._on_events(engine.evaluate_all(now), "reload")
         self.keeper.save(engine, self.dispatcher.orphans, self._fail_safes())
-        self.watcher = TopicWatcher(self._on_message, _log)
+        self.watcher = TopicWatcher(self._on_message, _log, self._on_spellings)
         self.watcher.sync(spec)
         self.agents = AgentBook()  # cpu and memory of nodes on other hosts, from their agents
         self._agent_sub = rospy.Subscriber(AGENT_TOPIC, String, self._on_agent, queue_size=100, tcp_nodelay=True)
         self.sampler = self._sampler(spec)
         self.load_error = ""
         rospy.loginfo("rubass: enforcing %s (%d rules, %d behaviours, %d topics, %d nodes)", spec.path,
-                      len(spec.rules), len(spec.behaviours), len(spec.topics), len(spec.nodes))
+                      len(spec.rules), len(spec.behaviours), len(self.watcher.topics), len(spec.nodes))  # distinct
         threading.Thread(target=self._engine_thread, name="rubass-engine", daemon=True).start()
 
     def _install_control(self) -> None:
@@ -302,6 +302,9 @@ class Monitor(Reloading):
 
     def _on_message(self, topic: str, now: float, msg: Any, wall: float, size: int) -> None:
         self.loop.submit(Message(topic, now, msg, wall, size))
+
+    def _on_spellings(self, topics: Tuple[str, ...], now: float, msg: Any, wall: float, size: int) -> None:
+        self.loop.submit(Message(topics[0], now, msg, wall, size, topics[1:]))
 
     def _on_agent(self, msg: String) -> None:
         try:

@@ -13,8 +13,6 @@ RULE = ("entity a { rules: r: age(topic cmd_vel) > 0.5 s and topic /cmd_vel.line
         "if (a.r) then { brake; }\n")
 
 
-@pytest.mark.xfail(strict=True, reason="needs Message.also in rubass/engine/loop.py and the monitor passing "
-                                       "TopicWatcher(submit_spellings=...) (see docs/failure-modes.md, two spellings)")
 def test_one_message_under_two_spellings_is_one_instant_and_starts_nothing(ros, tmp_path):
     mon = ros.monitor(spec(tmp_path, RULE))
     rec = ros.probe({"listen": [{"topic": "/rubass/events", "type": "std_msgs/String"}],
