@@ -127,6 +127,7 @@ class CustomPlugin(ActionPlugin):
                               f"{exc.__class__.__name__}: {exc}") from None
         self.per_behaviour = bool(getattr(self.impl, "per_behaviour", False))
         self.period = getattr(self.impl, "period", None)
+        self.call_timeout = float(getattr(self.impl, "call_timeout", 0.0) or 0.0)  # how long a call may block
 
     def _error(self, text: str) -> ActionSetupError:
         """The error as `rubass check` prints a library's: FILE:LINE:COL of its `plugin:` entry, the line, a caret."""

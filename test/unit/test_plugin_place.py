@@ -59,3 +59,19 @@ def test_a_merged_plugin_entry_is_named_where_the_anchor_gives_it(tmp_path):
                                    "  horn2:\n    <<: *h\n    a: 2\n")
     with pytest.raises(ActionSetupError, match=rf"^{path}:3:13: error: action 'horn2': cannot import"):
         make_plugin(actions["horn2"])
+
+
+def test_a_custom_plugin_may_say_how_long_its_calls_may_block(tmp_path, monkeypatch):
+    """Its `call_timeout` attribute moves the runner's stuck bound (2 s beyond it), as a service's
+    timeout does; without one, the bound is 2 s."""
+    from rubass.actions.runner import STUCK_AFTER, ActionRunner
+
+    (tmp_path / "robot_plug_slow.py").write_text(
+        "class Slow:\n    call_timeout = 5.0\n    def __init__(self, name, params): pass\n"
+        "    def start(self, ctx): pass\n    def hold(self, ctx): pass\n    def release(self, ctx): pass\n"
+        "class Quick(Slow):\n    call_timeout = None\n")
+    monkeypatch.syspath_prepend(str(tmp_path))
+    _, actions = load(tmp_path, "actions:\n  slow: {plugin: robot_plug_slow:Slow}\n  quick: {plugin: robot_plug_slow:Quick}\n")
+    log = lambda level, text: None  # noqa: E731
+    assert ActionRunner(make_plugin(actions["slow"]), log).stuck_after == STUCK_AFTER + 5.0
+    assert ActionRunner(make_plugin(actions["quick"]), log).stuck_after == STUCK_AFTER
