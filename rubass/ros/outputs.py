@@ -20,6 +20,10 @@ class Outputs:
         self.node_samples = rospy.Publisher("~node_samples", String, queue_size=100, tcp_nodelay=True)
         self._seq = 0
         self._hw = socket.gethostname()
+        # two monitors on one robot must not publish the same status names (an aggregator would merge
+        # them, one's OK masking the other's ERROR): a node other than /rubass says its name
+        node = rospy.get_name()
+        self._prefix = "rubass:" if node == "/rubass" else f"rubass {node}:"
 
     def beat(self, now: float) -> None:
         """One heartbeat; published from the engine's thread, so it stops if the engine stalls."""
@@ -39,7 +43,8 @@ class Outputs:
         arr = DiagnosticArray()
         arr.header.stamp = rospy.Time.from_sec(now)
         for e in entries:
-            arr.status.append(DiagnosticStatus(level=e.level, name=e.name,
+            name = e.name if not e.name.startswith("rubass:") else self._prefix + e.name[len("rubass:"):]
+            arr.status.append(DiagnosticStatus(level=e.level, name=name,
                                                message=e.message, hardware_id=self._hw,
                                                values=[KeyValue(key=k, value=v) for k, v in e.values]))
         self.diagnostics.publish(arr)
