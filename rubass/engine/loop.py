@@ -299,6 +299,11 @@ class EngineLoop:
             self._emit(self._on_message(m), m)
 
     def _handle(self, item: Any, queued: bool = True) -> None:
+        if isinstance(item, (Message, NodeSample)) and item.time < self._last_clock - self.jump_tolerance:
+            now = self.clock()  # behind the loop's clock: a late message, or the clock went back before
+            if now < self._last_clock - self.jump_tolerance:  # the engine's thread saw it: the jump, now,
+                self._clock_jumped(now)  # so that the old engine never reads a time of the new timeline
+                self._last_clock = now
         if self.clock_jumps and isinstance(item, (Message, NodeSample)) and \
                 item.time > self._last_clock + self.jump_tolerance:
             item = dataclasses.replace(item, time=self.clock())  # stamped on the old timeline, before the jump

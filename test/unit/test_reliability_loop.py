@@ -181,3 +181,30 @@ def test_after_a_clock_jump_active_of_a_held_action_stays_true_until_reset():
     assert 2 in loop.engine.active_behaviours()
     loop.engine.reset(clock.t)
     assert loop.engine.active_actions().get("stop") is None
+
+
+def test_a_message_on_the_new_timeline_before_the_loop_noticed_the_jump_starts_nothing():
+    """Acceptance finding (sim time, /clock reset from 112 s to 10 s): the first /odom message of the
+    new timeline was evaluated inline, by the old engine, before the engine's thread saw the jump:
+    age(/odom) read 108.98 s and `age(topic /odom) > 0.5 s` started a stop (released 1.5 s later).
+    A message whose time is behind the loop's clock, with the clock itself gone back, is the jump."""
+    spec = check_text("action primitive stop, warn;\nentity o { rules: silent: age(topic /odom) > 0.5 s; }\n"
+                      "if (o.silent) then { stop; }\n", os.path.join(ROOT, "x.rbs"), [LIB])
+    got = []
+    clock = Clock()
+    clock.t = 100.0
+    loop = EngineLoop(Engine(spec, clock.t), clock, 50.0, lambda events, cause: got.extend(events), inline=True)
+    for _ in range(40):  # /odom at 20 Hz on the old timeline
+        clock.t += 0.05
+        loop.submit(Message("/odom", clock.t, {"data": 1.0}))
+        loop.step(max_wait=0)
+    assert [e.kind for e in got if e.kind in ("start", "release")] == []
+    clock.t = 10.0  # the simulator is reset; the next message comes before the engine's thread wakes
+    clock.t += 0.05
+    loop.submit(Message("/odom", clock.t, {"data": 1.0}))
+    for _ in range(10):
+        clock.t += 0.05
+        loop.submit(Message("/odom", clock.t, {"data": 1.0}))
+        loop.step(max_wait=0)
+    assert loop.clock_jumps == 1
+    assert [e.kind for e in got if e.kind in ("start", "release")] == [], got
