@@ -163,6 +163,7 @@ class Engine:
             for action in node.actions:
                 node.users.update(readers.get(action, ()))
         self._readers = readers
+        self._released = False  # a release was emitted since the last _ordered()
         for topic in spec.topics:
             self.store.watch(topic, now, windows.get(topic, 0.0))
         explicit = spec.field_readers(implicit=False)  # header.stamp as a field, not only for stamp_age
@@ -202,7 +203,7 @@ class Engine:
         Evaluating between them would see a state that never existed at any instant (one
         topic updated, the other not yet) and could restart a `for`.
         """
-        events = self.advance(now, inclusive=False)
+        events = self._advance(now, inclusive=False)
         changed: Set[int] = set()  # the numbers of the field slots whose value changed
         if isinstance(items, tuple) and len(items) == 1:  # the live case: one message, its own plan
             topic, msg = items[0]
@@ -210,8 +211,8 @@ class Engine:
             plan = self._topic_plans.get(topic)
             if plan:
                 self._run(plan, events, changed)
-            events += self.advance(now)
-            return events
+            events += self._advance(now)
+            return self._ordered(events)
         topics = []
         for topic, msg in items:
             self._store_message(topic, now, msg, changed)
@@ -227,8 +228,8 @@ class Engine:
             plan = self._batch_plans[key] = tuple(sorted(seeds))
         if plan:
             self._run(plan, events, changed)
-        events += self.advance(now)
-        return events
+        events += self._advance(now)
+        return self._ordered(events)
 
     def _store_message(self, topic: str, now: float, msg: Any, changed: Set[Any]) -> None:
         store = self.store
@@ -265,28 +266,28 @@ class Engine:
 
     def on_node_sample(self, node: str, now: float, alive: Any, cpu: Any = UNKNOWN, memory: Any = UNKNOWN) -> List[Event]:
         """A sample of a node: alive True/False/UNKNOWN, cpu share of a core, memory bytes."""
-        events = self.advance(now, inclusive=False)
+        events = self._advance(now, inclusive=False)
         self.store.nodes[node] = {"alive": alive, "cpu": cpu, "memory": memory}
         plan = self._node_plans.get(node)
         if plan:
             self._run(plan, events, _NO_FIELDS)
-        events += self.advance(now)
-        return events
+        events += self._advance(now)
+        return self._ordered(events)
 
     def on_tick(self, now: float) -> List[Event]:
         """A scheduler tick: time-dependent expressions, then `hold` of every active behaviour."""
-        events = self.advance(now)
+        events = self._advance(now)
         self._run(self._tick_plan, events, _NO_FIELDS)
         for node in self._nodes:
             if node.active:
                 events.append(self._event(node, "hold"))
-        return events
+        return self._ordered(events)
 
     def evaluate_all(self, now: float) -> List[Event]:
         """Evaluate every rule and behaviour (at start, and after a reload)."""
-        events = self.advance(now)
+        events = self._advance(now)
         self._run(self._all, events)
-        return events
+        return self._ordered(events)
 
     def advance(self, now: float, inclusive: bool = True) -> List[Event]:
         """Fire every deadline up to `now` (before it, if not inclusive), each at its own instant.
@@ -294,6 +295,9 @@ class Engine:
         Inputs call this non-inclusively first: new data at t is the evaluation at t, so a
         `for` that a message at t falsifies never fires at t with the old data.
         """
+        return self._ordered(self._advance(now, inclusive))
+
+    def _advance(self, now: float, inclusive: bool = True) -> List[Event]:
         events: List[Event] = []
         while True:
             due = self.next_deadline()
@@ -305,6 +309,13 @@ class Engine:
             self._run(self._plan((idx,)), events, _NO_FIELDS)
         self.store.now = max(self.store.now, now)
         return events
+
+    def _ordered(self, events: List[Event]) -> List[Event]:
+        """starts_first(events) when a release was emitted since the last call; else as they are."""
+        if not self._released:
+            return events
+        self._released = False
+        return starts_first(events)
 
     def next_deadline(self) -> Optional[float]:
         """The next instant a value changes by itself: a `for`, `within`, a crossing of time."""
@@ -336,7 +347,7 @@ class Engine:
         seeds += [r for a in self._readers for r in self._readers[a]]
         if seeds:
             self._run(self._plan(seeds), events)
-        return events
+        return self._ordered(events)
 
     def hold_actions(self, actions: Iterable[str], holder: str, now: float) -> List[Event]:
         """Make actions active on behalf of an outside holder (a latch restored after a restart),
@@ -348,7 +359,7 @@ class Engine:
         seeds = [r for a in actions for r in self._readers.get(a, ())]
         if seeds:
             self._run(self._plan(seeds), events)
-        return events
+        return self._ordered(events)
 
     def release_holder(self, holder: str, now: float) -> List[Event]:
         """End an outside holder's hold on every action (before ~reset); readers of active() run."""
@@ -360,7 +371,7 @@ class Engine:
         seeds = [r for a in touched for r in self._readers.get(a, ())]
         if seeds:
             self._run(self._plan(seeds), events)
-        return events
+        return self._ordered(events)
 
     def outside_holders(self) -> Dict[str, Tuple[str, ...]]:
         """Holders other than this spec's behaviours (restored latches, …) and the actions they hold."""
@@ -480,7 +491,6 @@ class Engine:
         store, nodes, rules = self.store, self._nodes, self.store.rules
         moved: Set[int] = set()  # nodes whose value changed in this run
         incremental, now = changed is not None, store.now
-        first_event, released = len(events), False
         for i in plan:
             node = nodes[i]
             if incremental and not node.volatile and not node.fresh and node.due > now \
@@ -524,10 +534,7 @@ class Engine:
                     self._holders.get(a, set()).discard(node.key)
                 self._sync_actions()
                 events.append(self._event(node, "release"))
-                released = True
-        if released and len(events) - first_event > 1:  # one instant: its starts before its releases, so an
-            events[first_event:] = sorted(events[first_event:], key=_release_last)  # action one behaviour hands to
-            # another in this instant stays on (no on_release, no restart); each node runs once here
+                self._released = True
 
     def _schedule(self, idx: int, node: _Node) -> None:
         deadlines = node.compiled.deadlines()
@@ -544,8 +551,28 @@ _INSTANT_OPS = (ForOp, WithinOp, LatchOp)  # operators whose value moves only at
 _NO_FIELDS: FrozenSet[int] = frozenset()  # a tick, a deadline, a node sample: no field changed
 
 
-def _release_last(e: Event) -> bool:
-    return e.kind == "release"
+def starts_first(events: List[Event]) -> List[Event]:
+    """The events of each instant with its starts before its releases, so that an action one
+    behaviour hands to another in one instant (on a message, or at a deadline) gains its new holder
+    before it loses the old one: it stays on, no `on_release`, no second start. A behaviour that
+    releases and starts again in one instant keeps that order."""
+    out: List[Event] = []
+    i, n = 0, len(events)
+    while i < n:
+        t, j = events[i].time, i + 1
+        while j < n and events[j].time == t:
+            j += 1
+        group = events[i:j]
+        if len(group) > 1 and any(e.kind == "release" for e in group):
+            keep, late = [], []
+            for k, e in enumerate(group):
+                again = e.kind == "release" and any(g.kind == "start" and g.behaviour == e.behaviour
+                                                    for g in group[k + 1:])
+                (late if e.kind == "release" and not again else keep).append(e)
+            group = keep + late
+        out += group
+        i = j
+    return out
 
 
 def _same_ops(a: _Node, b: _Node) -> bool:
