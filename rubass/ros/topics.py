@@ -57,6 +57,9 @@ class TopicState:
     errors: List[str] = field(default_factory=list)
     subscriber: Optional[rospy.Subscriber] = None  # None until the registrar has made it
     cls: Any = None
+    # (md5, class, type) of the type evaluated, as one value: a callback of another publisher's
+    # thread reads it in one step, never a class of one type beside the md5 of another
+    decoder: Tuple[str, Any, str] = ("", None, "")
     gone: bool = False  # a reload dropped it (its subscription is dropped by the registrar)
     kinds: Dict[str, "topictypes.Kind"] = field(default_factory=dict)  # md5 -> a type seen now
     callers: Dict[str, Tuple[str, float]] = field(default_factory=dict)  # publisher -> (md5, newest message)
@@ -239,19 +242,23 @@ class TopicWatcher:
             self._send(state, now, None, wall, 0)  # age/frequency only: never deserialised
             return
         header = getattr(raw, "_connection_header", None) or {}
-        if header.get("md5sum", "") != state.md5 or (state.mixed is not None and wall - state.checked >= RECHECK):
+        md5 = header.get("md5sum", "")
+        md5_now, cls, type_name = state.decoder
+        if md5 != md5_now or (state.mixed is not None and wall - state.checked >= RECHECK):
             with self._types_lock:
                 evaluated = topictypes.admit(state, header, wall, self._new_kind, self.log)
+                kind = state.kinds.get(md5)
+                cls, type_name = (kind.cls, kind.type) if kind is not None else (None, header.get("type", "?"))
             if not evaluated:
                 return  # another type's message, while publishers of a type the spec can read are on
-        if state.cls is None:
+        if cls is None:
             self._send(state, now, UNKNOWN, wall, 0)
             return
         try:
-            msg = state.cls().deserialize(raw._buff)
+            msg = cls().deserialize(raw._buff)  # this message's own type's class (review: not state.cls)
         except (genpy.DeserializationError, ValueError, TypeError, IndexError, Exception) as exc:
             if not state.errors or not state.errors[-1].startswith("cannot deserialise"):
-                state.errors.append(f"cannot deserialise a {state.type} message: {exc}")
+                state.errors.append(f"cannot deserialise a {type_name} message: {exc}")
                 self.log("error", f"topic {state.resolved}: {state.errors[-1]}")
             msg = UNKNOWN
         else:

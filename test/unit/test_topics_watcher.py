@@ -181,3 +181,42 @@ def test_a_subscription_that_waits_for_the_master_blocks_neither_sync_nor_the_da
     watcher.close(wait=2.0)
     made = {s.name: s for s in BlockingSubscriber.made}
     assert set(made) == {"/newtopic2", "/other"} and all(s.unregistered for s in made.values())
+
+
+def test_two_readable_types_from_two_threads_are_each_read_with_their_own_class(monkeypatch):
+    """Review finding: the class was read from the topic's state after the type lock was released,
+    while the other publisher's thread switched it: a Float64 2.0 was read as a Float32 0.0 (a
+    `speed > 1` violation missed for that message). Each buffer is now read by its own type's class."""
+    import threading
+    import time
+
+    from std_msgs.msg import Float32, Float64
+
+    class SlowExitLock:  # the real lock; the thread is preempted right after releasing it (as the GIL may do)
+        def __init__(self):
+            self.lock = threading.Lock()
+
+        def __enter__(self):
+            self.lock.acquire()
+
+        def __exit__(self, *exc):
+            self.lock.release()
+            time.sleep(0.002)
+
+    monkeypatch.setattr(rospy, "Subscriber", FakeSubscriber)
+    watcher, state, got, logs = _watch()
+    watcher._types_lock = SlowExitLock()
+    r64, r32 = _raw(Float64(2.0), "/p64"), _raw(Float32(3.0), "/p32")
+
+    def run(raw):
+        for _ in range(100):
+            watcher._callback(raw, state)
+
+    threads = [threading.Thread(target=run, args=(r,)) for r in (r64, r32)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    seen = {(type(g[2]).__name__, getattr(g[2], "data", None)) for g in got}
+    assert seen <= {("Float64", 2.0), ("Float32", 3.0)}, seen
+    assert ("Float64", 2.0) in seen and ("Float32", 3.0) in seen
