@@ -14,6 +14,7 @@ starts and releases stay paired. Runs on the engine's thread (the loop's clock-j
 from __future__ import annotations
 
 import dataclasses
+import threading
 from typing import Any, Callable, List, Tuple
 
 from ..engine import Engine, Event
@@ -156,29 +157,38 @@ class ClockStall:
         self.now, self.wall, self.log = now, wall, log
         self._ros = now()
         self._since = wall()  # wall time ROS time last moved
-        self._said = False
+        self._said = False  # this stall was logged: its end will be too
         self._logged = float("-inf")
+        self._lock = threading.Lock()  # the watcher's thread and the status path both look
+
+    def _observe(self) -> Tuple[float, float]:
+        """(ROS time, wall seconds it has stood still); whoever first sees it move again says so."""
+        with self._lock:
+            ros, wall = self.now(), self.wall()
+            if ros == self._ros:
+                return ros, wall - self._since
+            if self._said:
+                self._said = False
+                self.log("info", f"/clock moves again (ROS time {ros:.3f} s) after {wall - self._since:.1f} s "
+                                 f"standing still")
+            self._ros, self._since = ros, wall
+            return ros, 0.0
 
     def stalled(self) -> str:
         """'' while ROS time moves; otherwise what to say (for /diagnostics)."""
-        ros, wall = self.now(), self.wall()
-        if ros != self._ros:
-            self._ros, self._since = ros, wall
-            return ""
-        still = wall - self._since
+        ros, still = self._observe()
         if still < self.AFTER:
             return ""
         return (f"no /clock for {still:.1f} s (use_sim_time): ROS time stands still at {ros:.3f} s, "
                 f"`for` and `age` cannot advance and no ~heartbeat is published until it moves")
 
     def check(self) -> None:
-        was = self._since
         text = self.stalled()
-        if text and not self._said and self.wall() - self._logged >= self.LOG_EVERY:
+        if not text:
+            return
+        with self._lock:
+            if self._said or self.wall() - self._logged < self.LOG_EVERY:
+                return
             self._said = True  # this stall is logged (and its end will be)
             self._logged = self.wall()
-            self.log("warn", text)
-        elif not text and self._said and self._since != was:
-            self._said = False
-            self.log("info", f"/clock moves again (ROS time {self._ros:.3f} s) after {self.wall() - was:.1f} s "
-                             f"standing still")
+        self.log("warn", text)

@@ -47,3 +47,20 @@ def test_stalls_that_come_back_quickly_are_logged_at_most_every_ten_seconds():
         stall.check()
     warns = [t for lvl, t in logs if lvl == "warn"]
     assert len(warns) == 2, logs  # at 2 s and again 10 s later, not five times
+
+
+def test_the_end_of_a_stall_is_said_when_the_status_sees_the_move_first_and_the_next_stall_is_said_too():
+    """Review finding: when /diagnostics (stalled()) was the first to see the clock move, check() never
+    said "moves again", and every later stall went unlogged."""
+    c, logs = Clocks(), []
+    stall = ClockStall(lambda: c.ros, lambda: c.wall, lambda level, text: logs.append((level, text)))
+    for _ in range(12):  # 3 s standing still: said
+        c.wall += 0.25
+        stall.check()
+    c.ros += 0.1
+    assert stall.stalled() == ""  # the status looks first
+    stall.check()
+    for _ in range(60):  # 15 s later, a second stall
+        c.wall += 0.25
+        stall.check()
+    assert [lvl for lvl, _ in logs] == ["warn", "info", "warn"], logs
