@@ -50,6 +50,7 @@ class ActionRunner:
         self._call_lock = threading.Lock()  # the call in progress, shared with the watchdog's thread
         self._call: Optional[Tuple[str, float]] = None  # (phase, monotonic start) of the plugin call running now
         self._stuck = False  # the call in progress has been reported stuck
+        self._before_stuck = ("", "")  # stats.failing and last_error when it was: given back when it returns
         self._stuck_log = 0.0
         plugin.wake = self.wake  # type: ignore[method-assign]
         plugin.stats = self.stats  # a plugin may count failures of its own threads (limit: a bad input)
@@ -84,6 +85,7 @@ class ActionRunner:
             first, self._stuck = not self._stuck, True
             if first:
                 self.stats.failures += 1
+                self._before_stuck = (self.stats.failing, self.stats.last_error)
             self.stats.failing = what
             self.stats.last_error = text
             say = first or now - self._stuck_log >= LOG_EVERY
@@ -262,7 +264,8 @@ class ActionRunner:
             return False
         except Exception as exc:  # a plugin's failure must never reach the engine
             self._returned()
-            self.stats.failures += 1
+            with self._call_lock:  # the watchdog counts too
+                self.stats.failures += 1
             self.stats.failing = what
             self.stats.last_error = f"{what}: {exc.__class__.__name__}: {exc}"
             now = time.monotonic()
@@ -281,11 +284,17 @@ class ActionRunner:
         return True
 
     def _returned(self) -> None:
-        """The plugin call returned: the watchdog no longer looks at it (a stuck phase that returned
-        successfully is then resolved by _resolve like any failure)."""
+        """The plugin call returned: the watchdog no longer looks at it. A call it reported stuck
+        gives the action back the failing state it had before (none, or another failure such as a
+        limit's bad input), with the stuck call kept on record; then the call's own outcome counts."""
         with self._call_lock:
-            self._call = None
-            self._stuck = False
+            stuck, self._call, self._stuck = self._stuck, None, False
+            if not stuck:
+                return
+            text, (failing, error) = self.stats.last_error, self._before_stuck
+            self.stats.failing = failing
+            self.stats.last_error = error if failing else RESOLVED + text
+        self.log("info", f"action '{self.plugin.name}' {text.split(' has not', 1)[0]} returned (it was stuck)")
 
     def _resolve(self, what: str) -> None:
         """A success after a failure: the error stays on record but no longer makes /diagnostics ERROR.

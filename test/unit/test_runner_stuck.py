@@ -99,7 +99,35 @@ def test_the_watchdog_reports_a_hanging_start_on_its_own_and_the_release_then_ru
         p.go.set()
         assert wait_for(lambda: p.calls == ["start", "release"])
         assert wait_for(lambda: not r.stats.failing)
-        assert any(level == "info" and "succeeded after failing" in t for level, t in logs)
+        assert any(level == "info" and "action 'hang' start returned (it was stuck)" in t for level, t in logs)
+        assert r.stats.last_error.startswith(RESOLVED) and "has not returned" in r.stats.last_error
+    finally:
+        p.go.set()
+        r.stop()
+
+
+@pytest.mark.parametrize("ends", ["skipped", "returns"])
+def test_a_stuck_call_that_ends_gives_back_the_failing_state_it_found(logs, monkeypatch, ends):
+    """Review finding: a stuck call that ended by Skipped left ACTION FAILING for good; one that
+    returned erased another failure of the action (a limit's bad input) with its own."""
+    monkeypatch.setattr(runner_mod, "STUCK_AFTER", 0.3)
+
+    class Hold(Hang):
+        def start(self, ctx):
+            self.calls.append("start")
+            self.go.wait(30)
+            if ends == "skipped":
+                raise runner_mod.Skipped("board away")
+
+    p = Hold()
+    r = make(p, logs)
+    try:
+        r.stats.failing, r.stats.last_error = "input", "input: /cmd_vel carries std_msgs/String"
+        r.submit("start", CTX)
+        assert wait_for(lambda: r.stats.failing == "start")
+        p.go.set()
+        assert wait_for(lambda: r.stats.failing != "start")
+        assert (r.stats.failing, r.stats.last_error) == ("input", "input: /cmd_vel carries std_msgs/String")
     finally:
         p.go.set()
         r.stop()
