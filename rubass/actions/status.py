@@ -114,6 +114,12 @@ def build(spec: CheckedSpec, rules: Dict[str, Any], active: List[int], topics: D
     return out
 
 
+def failing_of(stats: Dict[str, Any]) -> List[Tuple[str, str]]:
+    """(name, error) of the actions whose latest attempt failed, from each action's ActionStats
+    (`failing` is the phase that failed; a later success clears it, the error stays on record)."""
+    return [(name, st.last_error) for name, st in stats.items() if st.failing]
+
+
 def not_enforcing(spec_path: str, error: str, reloads: int, rejected: int) -> List[Entry]:
     """The monitor's only status while no spec could be used: ERROR, naming the file and the error."""
     first = error.splitlines()[0] if error else "no spec loaded"

@@ -404,7 +404,7 @@ class Monitor(Reloading):
         for name, r in self.runners.items():
             if r.stats.last_error:
                 monitor[f"action {name}"] = r.stats.last_error
-        failing = [(name, r.stats.last_error) for name, r in self.runners.items() if r.stats.failing]
+        failing = status_mod.failing_of({name: r.stats for name, r in self.runners.items()})
         monitor.update(self.keeper.status())
         monitor["clock jumps back"] = loop.clock_jumps
         if loop.dropped_by_topic:

@@ -1,7 +1,6 @@
 """Issue 13 (5): a failing action is retried with a bounded backoff, never in a spin, while holds
 keep coming; its periodic work goes on meanwhile. Issue 20 (3): two calls of one action in one
 behaviour both run."""
-import threading
 import time
 
 from rubass.lang.library import ActionDef
@@ -173,8 +172,8 @@ def test_a_failure_is_marked_resolved_by_the_next_success_and_the_monitor_is_ok_
     def monitor_level():
         spec = check_text("entity base { rules: fast: topic /cmd_vel.linear.x > 1; }\n")
         monitor = {"failed action attempts": r.stats.failures, "action stop": r.stats.last_error}
-        failing = [("stop", r.stats.last_error)] if r.stats.failing else []
-        return status.build(spec, {"base.fast": False}, [], {}, {}, {}, monitor, failing)[-1].level
+        return status.build(spec, {"base.fast": False}, [], {}, {}, {}, monitor,
+                            status.failing_of({"stop": r.stats}))[-1].level
 
     try:
         r.submit("start", Context(1, 3))

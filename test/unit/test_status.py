@@ -33,11 +33,15 @@ def test_an_overloaded_monitor_is_error_and_names_the_fail_safe_actions():
 
 def test_an_action_failure_is_error_only_until_a_later_attempt_succeeds():
     """A stop that reached no subscriber once, then did: the count stays on record, the level is OK."""
+    from rubass.actions.base import ActionStats
     error = "start: OSError: no node subscribes to /x"
-    failing = monitor_entry([("stop2", error)], **{"failed action attempts": 3, "action stop2": error})
+    stats = {"stop2": ActionStats(failures=3, last_error=error, failing="start"), "warn": ActionStats(calls=2)}
+    failing = monitor_entry(status.failing_of(stats), **{"failed action attempts": 3, "action stop2": error})
     assert failing.level == status.ERROR
     assert "ACTION FAILING: stop2: start: OSError: no node subscribes to /x" in failing.message
-    resolved = monitor_entry(**{"failed action attempts": 3, "action stop2": status.RESOLVED + error})
+    stats["stop2"] = ActionStats(failures=3, last_error=status.RESOLVED + error, failing="")  # a later success
+    resolved = monitor_entry(status.failing_of(stats),
+                             **{"failed action attempts": 3, "action stop2": status.RESOLVED + error})
     assert resolved.level == status.OK and "FAILING" not in resolved.message
     assert ("failed action attempts", "3") in resolved.values
 
