@@ -35,6 +35,12 @@ class Context:
         return (self.behaviour if self.key is None else self.key, self.args)
 
 
+class Skipped(Exception):
+    """Raised by a plugin's phase that did nothing this time by design, neither a success nor a failure
+    (not counted, resolves nothing; a start or release is retried): a hold while the serial board is
+    away between two reopen attempts, or while the previous call of a service has not returned."""
+
+
 @dataclass
 class ActionStats:
     calls: int = 0
@@ -69,10 +75,16 @@ class ActionPlugin:
     def claim(self) -> None:
         """A start of this action is about to be submitted: called on the engine's thread for every
         start of one instant before any runner runs; must not block. A plugin that shares a topic by
-        priority takes its seat here."""
+        priority (its `seat`, from the arbiter) takes it here."""
+        seat = getattr(self, "seat", None)
+        if seat is not None:
+            seat.claim()
 
     def unclaim(self) -> None:
         """A claimed start was dropped unrun (its release followed it in a full queue)."""
+        seat = getattr(self, "seat", None)
+        if seat is not None:
+            seat.unclaim()
 
     def start(self, ctx: Context) -> None:
         """The behaviour turned true."""
@@ -190,4 +202,4 @@ def describe(ctx: Context) -> str:
     return f"behaviour {ctx.behaviour} (line {ctx.line}){rules}"
 
 
-__all__: List[str] = ["ActionPlugin", "ActionSetupError", "ActionStats", "Context", "CustomPlugin", "make_plugin"]
+__all__: List[str] = ["ActionPlugin", "ActionSetupError", "ActionStats", "Skipped", "Context", "CustomPlugin", "make_plugin"]

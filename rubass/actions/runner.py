@@ -12,7 +12,7 @@ import time
 import weakref
 from typing import Any, Callable, Deque, Dict, Optional, Set, Tuple
 
-from .base import ActionPlugin, ActionStats, Context
+from .base import ActionPlugin, ActionStats, Context, Skipped
 from .status import RESOLVED
 
 Log = Callable[[str, str], None]  # (level, text)
@@ -25,12 +25,6 @@ WATCH_EVERY = 0.25  # how often the watchdog looks at the calls in progress
 # (a good input: holds succeed at 50 Hz whatever the input); the runner's own by the next phase
 _RESOLVED_BY = {"start": ("start", "release"), "release": ("release", "start"),
                 "hold": ("hold", "start", "release"), "periodic": ("periodic",), "input": ()}
-
-
-class Skipped(Exception):
-    """Raised by a plugin's phase that did nothing this time by design, neither a success nor a failure
-    (not counted, resolves nothing; a start or release is retried): a hold while the serial board is
-    away between two reopen attempts, or while the previous call of a service has not returned."""
 
 
 class ActionRunner:

@@ -9,7 +9,7 @@ import queue
 import threading
 import time
 from dataclasses import dataclass, field
-from typing import Any, Callable, Dict, FrozenSet, List, Optional, Set, Tuple
+from typing import Any, Callable, Dict, FrozenSet, List, Optional, Set, Tuple, Union
 
 import genpy
 import genpy.dynamic
@@ -87,7 +87,9 @@ class TopicWatcher:
         self._lock = threading.Lock()
         self._types_lock = threading.Lock()  # a topic's types (topictypes.py): no rospy call under it
         self._classes: Dict[str, Any] = {}  # md5 -> class
-        self._jobs: "queue.Queue[Optional[Tuple[str, TopicState]]]" = queue.Queue()
+        # ("subscribe" | "unsubscribe", TopicState), a threading.Event to set once the jobs before it
+        # are done, or None to end the registrar
+        self._jobs: "queue.Queue[Union[Tuple[str, TopicState], threading.Event, None]]" = queue.Queue()
         self._registrar: Optional[threading.Thread] = None
         self._closed = False
         self.clock: Optional[ClockStall] = None  # with use_sim_time: says when /clock stops
@@ -145,7 +147,7 @@ class TopicWatcher:
         done = threading.Event()
         for job in jobs:
             self._jobs.put(job)
-        self._jobs.put(("done", done))  # type: ignore[arg-type]
+        self._jobs.put(done)
         self._start_registrar()
         done.wait(wait)
 
@@ -160,11 +162,12 @@ class TopicWatcher:
             job = self._jobs.get()
             if job is None:
                 return
+            if isinstance(job, threading.Event):
+                job.set()  # the jobs queued before it are done
+                continue
             kind, state = job
             try:
-                if kind == "done":
-                    state.set()  # type: ignore[attr-defined]
-                elif kind == "subscribe":
+                if kind == "subscribe":
                     self._subscribe(state)
                 elif state.subscriber is not None:
                     sub, state.subscriber = state.subscriber, None

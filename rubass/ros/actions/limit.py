@@ -81,14 +81,6 @@ class LimitPlugin(ActionPlugin):
             self._publish(msg)
 
     # -- the runner's thread ---------------------------------------------------------------
-    def claim(self) -> None:
-        if self.seat is not None:
-            self.seat.claim()
-
-    def unclaim(self) -> None:
-        if self.seat is not None:
-            self.seat.unclaim()
-
     def start(self, ctx: Context) -> None:
         with self._lock:
             self._on = True

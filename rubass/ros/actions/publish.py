@@ -69,14 +69,6 @@ class PublishPlugin(ActionPlugin):
                 self.pub.publish(msg)
             return mine and self.pub is not None
 
-    def claim(self) -> None:
-        if self.seat is not None:
-            self.seat.claim()
-
-    def unclaim(self) -> None:
-        if self.seat is not None:
-            self.seat.unclaim()
-
     def start(self, ctx: Context) -> None:
         assert self.pub is not None
         self.seat.activate()

@@ -11,7 +11,7 @@ import rospy
 import serial
 
 from ...actions.base import ActionPlugin, Context
-from ...actions.runner import Skipped
+from ...actions.base import Skipped
 
 REOPEN_PERIOD = 0.5
 

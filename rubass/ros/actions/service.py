@@ -11,7 +11,7 @@ import roslib.message
 import rospy
 
 from ...actions.base import ActionPlugin, Context
-from ...actions.runner import Skipped
+from ...actions.base import Skipped
 from ..rpc import proxy
 from .publish import build_message, ros_class
 
