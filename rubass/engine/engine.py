@@ -12,8 +12,6 @@ from __future__ import annotations
 import heapq
 import itertools
 import math
-import sys
-from dataclasses import dataclass
 from typing import AbstractSet, Any, Dict, FrozenSet, Iterable, List, Optional, Set, Tuple
 
 from ..lang import ast
@@ -21,24 +19,11 @@ from ..lang.model import CheckedBehaviour, CheckedSpec
 from .evaluate import Compiled, Compiler
 from .explain import Explainer, Witness
 from .fields import FieldError, extract
+from .events import Event, starts_first
 from .operators import ForOp, LatchOp, WithinOp
+from .readings import STAMP, laser_limits, stamp_seconds
 from .store import Store
 from .values import UNKNOWN
-
-
-@dataclass(frozen=True)
-class Event:
-    """A change: a behaviour's start/hold/release, or a rule's new value ('rule')."""
-
-    time: float
-    kind: str
-    behaviour: int = 0  # 1-based, in file order
-    rule: str = ""
-    value: Any = None
-    actions: Tuple[str, ...] = ()
-    line: int = 0
-    name: str = ""  # the behaviour's name (§14), "" when unnamed
-    witness: Optional[Witness] = None  # at a start: the true rules and the values they read (explain.py)
 
 
 class _Node:
@@ -245,12 +230,12 @@ class Engine:
             store.arrive_rate(topic, path, now, store.fields.get((topic, path), UNKNOWN))
         if topic in self._stamped:
             try:
-                stamp = UNKNOWN if msg is UNKNOWN else _stamp(extract(msg, STAMP, raw=True))
+                stamp = UNKNOWN if msg is UNKNOWN else stamp_seconds(extract(msg, STAMP, raw=True))
             except FieldError:
                 stamp = UNKNOWN  # a type with no header.stamp: stamp_age is unknown (§11)
             store.stamps[topic] = stamp
         if topic in self._laser:
-            store.laser_limits[topic] = _laser_limits(msg)
+            store.laser_limits[topic] = laser_limits(msg)
 
     def _read(self, topic: str, path: Tuple[ast.PathElem, ...], msg: Any, key: str) -> Any:
         if msg is UNKNOWN:  # the shell could not read it: its fields are missing data
@@ -545,66 +530,12 @@ class Engine:
                 heapq.heappush(self._heap, (due, next(self._seq), idx, op))
 
 
-STAMP: Tuple[ast.PathElem, ...] = ("header", "stamp")
 _ABSENT = object()  # a rule not evaluated yet
 _INSTANT_OPS = (ForOp, WithinOp, LatchOp)  # operators whose value moves only at inputs and deadlines
 _NO_FIELDS: FrozenSet[int] = frozenset()  # a tick, a deadline, a node sample: no field changed
-
-
-def starts_first(events: List[Event]) -> List[Event]:
-    """The events of each instant with its starts before its releases, so that an action one
-    behaviour hands to another in one instant (on a message, or at a deadline) gains its new holder
-    before it loses the old one: it stays on, no `on_release`, no second start. A behaviour that
-    releases and starts again in one instant keeps that order."""
-    out: List[Event] = []
-    i, n = 0, len(events)
-    while i < n:
-        t, j = events[i].time, i + 1
-        while j < n and events[j].time == t:
-            j += 1
-        group = events[i:j]
-        if len(group) > 1 and any(e.kind == "release" for e in group):
-            keep, late = [], []
-            for k, e in enumerate(group):
-                again = e.kind == "release" and any(g.kind == "start" and g.behaviour == e.behaviour
-                                                    for g in group[k + 1:])
-                (late if e.kind == "release" and not again else keep).append(e)
-            group = keep + late
-        out += group
-        i = j
-    return out
 
 
 def _same_ops(a: _Node, b: _Node) -> bool:
     """Whether an edited rule's stateful operators line up with its former ones (same kinds, same
     order), so that their state can carry across a reload."""
     return bool(a.compiled.ops) and [type(o) for o in a.compiled.ops] == [type(o) for o in b.compiled.ops]
-
-
-def _stamp(value: Any) -> Any:
-    """header.stamp as seconds; unknown for a zero stamp or one that cannot be read."""
-    to_sec = getattr(value, "to_sec", None)  # genpy Time
-    if callable(to_sec):
-        value = float(to_sec())
-    if isinstance(value, (int, float)) and not isinstance(value, bool):
-        value = float(value)
-        return value if value > 0 and value == value else UNKNOWN
-    if isinstance(value, dict):
-        secs, nsecs = value.get("secs"), value.get("nsecs", 0)
-        if isinstance(secs, (int, float)) and isinstance(nsecs, (int, float)):
-            t = float(secs) + float(nsecs) * 1e-9
-            return t if t > 0 else UNKNOWN
-    return UNKNOWN
-
-
-def _laser_limits(msg: Any) -> Optional[Tuple[float, float]]:
-    """(range_min, range_max) of a sensor_msgs/LaserScan (REP 117), None for any other type."""
-    try:
-        lo, hi = extract(msg, ("range_min",)), extract(msg, ("range_max",))
-    except FieldError:
-        return None
-    # limits a driver left unset (0 and 0, NaN, inf) would make every reading invalid, the sector
-    # unknown and its stop released: such a bound is ignored (readings count from 0 m, finite ones)
-    lo = lo if type(lo) is float and math.isfinite(lo) and lo >= 0.0 else 0.0
-    hi = hi if type(hi) is float and math.isfinite(hi) and hi > lo else sys.float_info.max
-    return lo, hi

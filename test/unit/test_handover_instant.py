@@ -83,7 +83,7 @@ def test_a_hand_over_at_a_deadline_keeps_the_action_on(order):
 
 def test_starts_first_keeps_a_release_before_the_same_behaviours_start_again():
     from rubass.engine import Event
-    from rubass.engine.engine import starts_first
+    from rubass.engine.events import starts_first
     events = [Event(1.0, "release", 1), Event(1.0, "start", 2), Event(1.0, "start", 1), Event(2.0, "release", 2),
               Event(2.0, "rule", rule="e.r"), Event(2.0, "start", 3)]
     assert [(e.time, e.kind, e.behaviour) for e in starts_first(events)] == [

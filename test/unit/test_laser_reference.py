@@ -28,7 +28,7 @@ def test_limits_a_driver_left_unset_are_ignored_not_a_blind_scan():
     invalid, `min(ranges) < 0.5 m` unknown, and the stop released. Such bounds are ignored now;
     NaN and +inf readings stay no reading, -inf stays 0 m."""
 
-    from rubass.engine.engine import _laser_limits
+    from rubass.engine.readings import laser_limits as _laser_limits
 
     ranges = (2.0, 0.3, math.nan, math.inf)
     for lo, hi in ((0.0, 0.0), (math.nan, math.nan), (0.1, math.inf), (0.5, 0.2), (-1.0, 30.0)):
