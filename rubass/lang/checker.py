@@ -402,7 +402,8 @@ def _sign_behaviours(behaviours: List[CheckedBehaviour], rules: List[CheckedRule
     out = []
     for b in behaviours:
         keys = sorted({e.key for e in _walk(b.cond) if type(e) is ast.RuleRef})
-        out.append(dataclasses.replace(b, signature=b.signature + "".join(f" [{k}: {sigs[k]}]" for k in keys)))
+        out.append(dataclasses.replace(b, signature=b.signature + "".join(f" [{k}: {sigs[k]}]" for k in keys),
+                                       own_signature=b.signature))
     return out
 
 

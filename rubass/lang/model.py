@@ -50,13 +50,15 @@ class CheckedBehaviour:
     signature: str
     name: str = ""  # `name: if (…)` (§14); "" for an unnamed behaviour
     attrs: Attrs = field(default_factory=dict)
+    own_signature: str = ""  # its condition and actions as written, without the rules it names
 
     @property
     def identity(self) -> str:
         """Who it is across a live reload, for the engine and the dispatcher alike: its name and its
-        actions, or (unnamed) its condition and actions."""
+        actions, or (unnamed) its condition and actions as written, so that editing a rule it
+        names does not make it another behaviour (its stop would be released and started again)."""
         if not self.name:
-            return f"sig:{self.signature}"
+            return f"sig:{self.own_signature or self.signature}"
         return f"name:{self.name} {{{' '.join(a.name + repr(a.args) for a in self.actions)}}}"
 
     @property

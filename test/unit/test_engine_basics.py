@@ -105,7 +105,9 @@ def test_reload_keeps_unchanged_rules_timers_and_active_behaviours():
     assert [(e.kind, e.behaviour) for e in events if e.kind != "rule"] == []  # `if (a.r)` did not restart
     assert new.rule_value("a.q") is False  # changed rule re-evaluated on the kept data
     assert [(e.kind, e.behaviour) for e in new.advance(2.0) if e.kind != "rule"] == [("start", 2)]
-    assert [b.checked.index for b in new.orphans] == [2]  # old `if (a.q)` (stop) was active, is gone
+    # `if (a.q) then { stop; }` is the same behaviour (condition and actions as written), moved to
+    # number 1: carried, and its latched stop stays on though its edited rule is false now
+    assert new.active_behaviours() == [1, 2] and new.orphans == []
 
 
 def test_an_edited_for_rule_keeps_its_history_so_an_active_stop_is_not_released():
@@ -141,3 +143,21 @@ def test_behaviour_rules_names_the_true_causes():
     e = engine("entity a { rules: p: topic /x.data > 1; q: topic /y.data > 1; }\nif (a.p or a.q) then { warn; }\n")
     e.on_message("/y", 1.0, {"data": 3})
     assert e.behaviour_rules(1) == ["a.q"]
+
+
+def test_an_unnamed_behaviour_is_the_same_behaviour_when_a_rule_it_names_is_edited():
+    """Re-sweep finding: the carry above worked for a named behaviour only; an unnamed one (as the
+    README writes them) took the rules' texts into its identity, so the edit made it another
+    behaviour: released at the reload (on_release sent) and started again."""
+    from rubass.actions.dispatch import Dispatcher
+
+    a = "entity a {{ rules: fast: (topic /speed.data > {}) for 1 s; }}\nif (a.fast) then {{ warn; }}\n"
+    old = build(a.format(1), 0.0)
+    old.evaluate_all(0.0)
+    old.on_message("/speed", 0.5, {"data": 2.0})
+    assert [e.kind for e in old.advance(1.5) if e.kind != "rule"] == ["start"]
+    new = build(a.format(1.1), 0.0)
+    assert Dispatcher.keys(old.spec.behaviours) == Dispatcher.keys(new.spec.behaviours)
+    assert [e.kind for e in new.adopt(old, 2.0) if e.kind != "rule"] == []
+    assert new.active_behaviours() == [1] and not new.orphans
+    assert [e.kind for e in new.on_message("/speed", 3.0, {"data": 1.05}) if e.kind != "rule"] == ["release"]
