@@ -452,10 +452,30 @@ class Monitor(Reloading):
         received = sum(st.messages for st in self.watcher.status())
         rospy.loginfo("rubass: stopped after %d messages (%d dropped: the engine's queue was full), %d reloads",
                       received, loop.dropped, self.reloads)
+        # the releases are handed to the actions' threads; what follows unregisters from rospy, which
+        # may wait for good for a master that does not answer (a registration holds its lock)
+        _exit_within(EXIT_GRACE + 1.0 * len(self.runners))
         self.watcher.close()
         for runner in self.runners.values():
             runner.stop(timeout=1.0)
             runner.plugin.close()
+
+
+EXIT_GRACE = 5.0  # s: rospy's own shutdown, after the monitor's, before the process exits anyway
+
+
+def _exit_within(seconds: float) -> None:
+    """Exit 0 after `seconds` whatever is still running: rospy's shutdown waits for a subscription
+    that retries a master which is down (its topic manager's lock), and so did the process, for good."""
+    def cut() -> None:
+        time.sleep(seconds)
+        sys.stderr.write(f"[rubass] rospy did not shut down within {seconds:g} s (a registration waits for the "
+                         f"master): exiting; the monitor had already stopped\n")
+        sys.stderr.flush()
+        sys.stdout.flush()
+        os._exit(0)
+
+    threading.Thread(target=cut, name="rubass-exit", daemon=True).start()
 
 
 def main(argv: Optional[List[str]] = None) -> int:

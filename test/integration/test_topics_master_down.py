@@ -61,3 +61,27 @@ def test_a_reload_adding_a_topic_while_the_master_is_down_stops_nothing_from_bei
     sent, brake = first(rec, "sent", "/newtopic2"), first(rec, "recv", "/brake")
     assert brake is not None and brake["wall"] - sent["wall"] < 0.1, ros.log(mon)
     assert mon.poll() is None
+
+
+def test_sigterm_exits_while_a_subscription_waits_for_the_master(ros, tmp_path):
+    """Re-sweep finding: after such a reload, SIGTERM logged "stopped" but the process stayed (25 s,
+    then SIGKILL): rospy's shutdown waited for the registration that retries the absent master.
+    The monitor releases its actions, then exits 0 within a few seconds whatever rospy waits for."""
+    import time
+
+    path = spec(tmp_path, FAST)
+    mon = ros.monitor(path)
+    ros.master.stop()
+    with open(path, "a") as fh:
+        fh.write(NEW)
+    os.kill(mon.pid, signal.SIGHUP)
+    wait_log(mon, ros, "topic /newtopic2: the master does not answer", timeout=10)
+    t0 = time.monotonic()
+    mon.send_signal(signal.SIGTERM)
+    try:
+        status = mon.wait(15)
+    except Exception:
+        raise AssertionError(ros.log(mon))
+    assert status == 0, ros.log(mon)
+    assert time.monotonic() - t0 < 12, time.monotonic() - t0  # 5 s + 1 s per action (3), at most
+    assert "stopped after" in ros.log(mon)
