@@ -98,7 +98,15 @@ class Reloading:
                     raise StartupError(f"{spec.path}: the new spec no longer declares {', '.join(gone)}, which is "
                                        f"latched and active, and no action library it loads defines it any more "
                                        f"(renamed or removed); call ~reset first (or keep the action's name)")
-                runners = self._runners(spec, self.runners)
+                slow = threading.Timer(1.0, lambda: rospy.logwarn(
+                    "rubass: reload (%s): setting up its new actions waits for the master (a new publisher or "
+                    "service registers with it); the previous rules keep running until it answers", reason))
+                slow.daemon = True
+                slow.start()  # a reload that waits silently looks like one that took effect
+                try:
+                    runners = self._runners(spec, self.runners)
+                finally:
+                    slow.cancel()
             except (SpecError, StartupError) as exc:
                 text = exc.render() if isinstance(exc, SpecError) else str(exc)
                 self.rejected += 1

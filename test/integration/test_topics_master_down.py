@@ -85,3 +85,23 @@ def test_sigterm_exits_while_a_subscription_waits_for_the_master(ros, tmp_path):
     assert status == 0, ros.log(mon)
     assert time.monotonic() - t0 < 12, time.monotonic() - t0  # 5 s + 1 s per action (3), at most
     assert "stopped after" in ros.log(mon)
+
+
+def test_a_reload_adding_a_publish_action_while_the_master_is_down_says_it_waits(ros, tmp_path):
+    """Re-sweep finding: such a reload waited for the master (its new publisher registers with it)
+    without a word: the new rule was silently not enforced. It says so now; the old rules go on."""
+    from rosharness import LIB
+
+    path = spec(tmp_path, FAST)
+    mon = ros.monitor(path)
+    ros.master.stop()
+    (tmp_path / "lib.yaml").write_text(LIB + "  horn: {plugin: publish, topic: /horn, type: std_msgs/Bool, "
+                                              "message: {data: true}, rate: 5 Hz}\n")
+    with open(path, "a") as fh:
+        fh.write("action primitive horn;\nentity h { rules: loud: topic /cmd_vel.angular.z > 1; }\n"
+                 "if (h.loud) then { horn; }\n")
+    os.kill(mon.pid, signal.SIGHUP)
+    wait_log(mon, ros, "setting up its new actions waits for the master", timeout=10)
+    assert "reloaded" not in ros.log(mon) and mon.poll() is None
+    ros.master.restart()
+    wait_log(mon, ros, "reloaded", timeout=20)
