@@ -98,3 +98,28 @@ def test_a_runner_trying_a_hung_service_for_seconds_keeps_one_thread_and_counts_
     finally:
         p.proxy.go.set()
         r.stop()
+
+
+def test_a_reload_that_rebuilds_the_action_does_not_start_a_second_abandoned_call():
+    """Re-sweep finding: every reload that changed the action (its timeout 0.3 s <-> 0.4 s) built a new
+    plugin with no memory of the hung call, and started another: 8 reloads, 8 more threads."""
+    from rubass.ros.actions import service
+    end = time.monotonic() + 5
+    while workers() and time.monotonic() < end:  # the tests above answered their hung calls
+        time.sleep(0.01)
+    service._HUNG.clear()
+    first = brake(timeout=0.3)
+    try:
+        with pytest.raises(TimeoutError, match="did not answer"):
+            first.start(CTX)
+        for timeout in (0.4, 0.3, 0.4):  # the reloads: a new plugin of the same action each time
+            again = brake(timeout=timeout)
+            again.proxy = first.proxy
+            with pytest.raises(TimeoutError, match="the previous call to /brake has not returned"):
+                again.start(CTX)
+        assert first.proxy.calls == 1 and len(workers()) == 1
+    finally:
+        first.proxy.go.set()
+        end = time.monotonic() + 5
+        while workers() and time.monotonic() < end:
+            time.sleep(0.01)

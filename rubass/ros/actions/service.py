@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import threading
 import time
-from typing import Any, List, Optional, Tuple
+from typing import Any, Dict, List, Optional, Tuple
 
 import rosgraph
 import roslib.message
@@ -16,6 +16,12 @@ from ..rpc import proxy
 from .publish import build_message, ros_class
 
 
+# the abandoned call of each action (by name) while it has not returned: (thread, monotonic start,
+# its stage). Kept here, not on the plugin, so that a reload that rebuilds the action (a new timeout)
+# does not start a second abandoned call beside the first: at most one per action, across reloads
+_HUNG: Dict[str, Tuple[threading.Thread, float, List[str]]] = {}
+
+
 class ServicePlugin(ActionPlugin):
     def setup(self) -> None:
         cls = ros_class(roslib.message.get_service_class, self.params["type"], f"action '{self.name}'", "service")
@@ -23,8 +29,17 @@ class ServicePlugin(ActionPlugin):
                                      f"action '{self.name}': request")
         self.proxy = rospy.ServiceProxy(self.params["service"], cls)
         self.call_timeout = float(self.params["timeout"]) + 1.0  # the runner's stuck bound: the call and _advertised
-        # the abandoned call while it has not returned: (thread, monotonic start, its stage)
-        self._hung: Optional[Tuple[threading.Thread, float, List[str]]] = None
+
+    @property
+    def _hung(self) -> Optional[Tuple[threading.Thread, float, List[str]]]:
+        return _HUNG.get(self.name)
+
+    @_hung.setter
+    def _hung(self, value: Optional[Tuple[threading.Thread, float, List[str]]]) -> None:
+        if value is None:
+            _HUNG.pop(self.name, None)
+        else:
+            _HUNG[self.name] = value
 
     def _previous_returned(self, phase: str) -> None:
         """Raise while the call abandoned last time is still in the service (a wait for the service
