@@ -33,10 +33,8 @@ Signals
 """
 from __future__ import annotations
 
-import os
 import queue
 import signal
-import sys
 import threading
 import time
 from typing import Any, Dict, List, Optional, Tuple
@@ -65,11 +63,11 @@ from ..actions.overload import OverloadGuard
 from .clockjump import ClockJump
 from ..actions.errorguard import ErrorGuard
 from ..actions.keeper import LatchKeeper
-from ..actions.latches import LatchFile, adopt_old_default, default_path
-from .rosout_param import keep_rosout_flag
-from .params import MonitorConfig, ParamError, read_config, spec_warnings, unknown_params
+from ..actions.latches import LatchFile
+from .params import MonitorConfig, spec_warnings
 from .gcfreeze import freeze_heap
 from .timerslack import exact_timers
+from .exiting import EXIT_GRACE, exit_within
 from .reloading import ConfigError, Reloading, StartupError
 from .topics import TopicWatcher, ros_now
 
@@ -454,52 +452,8 @@ class Monitor(Reloading):
                       received, loop.dropped, self.reloads)
         # the releases are handed to the actions' threads; what follows unregisters from rospy, which
         # may wait for good for a master that does not answer (a registration holds its lock)
-        _exit_within(EXIT_GRACE + 1.0 * len(self.runners))
+        exit_within(EXIT_GRACE + 1.0 * len(self.runners))
         self.watcher.close()
         for runner in self.runners.values():
             runner.stop(timeout=1.0)
             runner.plugin.close()
-
-
-EXIT_GRACE = 5.0  # s: rospy's own shutdown, after the monitor's, before the process exits anyway
-
-
-def _exit_within(seconds: float) -> None:
-    """Exit 0 after `seconds` whatever is still running: rospy's shutdown waits for a subscription
-    that retries a master which is down (its topic manager's lock), and so did the process, for good."""
-    def cut() -> None:
-        time.sleep(seconds)
-        sys.stderr.write(f"[rubass] rospy did not shut down within {seconds:g} s (a registration waits for the "
-                         f"master): exiting; the monitor had already stopped\n")
-        sys.stderr.flush()
-        sys.stdout.flush()
-        os._exit(0)
-
-    threading.Thread(target=cut, name="rubass-exit", daemon=True).start()
-
-
-def main(argv: Optional[List[str]] = None) -> int:
-    rospy.init_node("rubass", argv=argv, disable_signals=True)  # Monitor handles SIGINT/SIGTERM
-    keep_rosout_flag()  # no log call asks the master anything (one would block while its host is cut off)
-    sys.setswitchinterval(0.0005)  # a busy thread must not delay a deadline by the default 5 ms
-    try:
-        names = rospy.get_param_names()
-    except Exception:  # noqa: BLE001 - only a warning is lost; read_config says what is wrong
-        names = []
-    for warning in unknown_params(names, rospy.get_name()):  # a typo must not pass silently
-        rospy.logwarn("rubass: %s", warning)
-    state_file = default_path(os.environ.get("ROS_HOME"), rospy.get_name())
-    if rospy.get_name() == "/rubass":  # a plain rosrun was /rubass_monitor before version 2's last stop
-        old = default_path(os.environ.get("ROS_HOME"), "/rubass_monitor")
-        if adopt_old_default(state_file, old):
-            rospy.logwarn("rubass: latch state %s moved to %s (the node's new default name)", old, state_file)
-    try:
-        config = read_config(lambda name, default: rospy.get_param("~" + name, default), state_file)
-        monitor = Monitor(config)
-        monitor.setup()
-    except (ParamError, ConfigError) as exc:
-        rospy.logfatal("rubass: cannot start:\n%s", exc)  # on stderr and in rosout: printed once
-        rospy.signal_shutdown("cannot start")
-        return 1
-    monitor.run()
-    return 0

@@ -1,0 +1,41 @@
+"""`rosrun rubass monitor`: the monitor node's entry point (rubass/ros/monitor.py holds the node).
+Parameters are read and checked here; a bad one is a FATAL line and exit 1, never a traceback."""
+from __future__ import annotations
+
+import os
+import sys
+from typing import List, Optional
+
+import rospy
+
+from ..actions.latches import adopt_old_default, default_path
+from .monitor import ConfigError, Monitor
+from .params import ParamError, read_config, unknown_params
+from .rosout_param import keep_rosout_flag
+
+
+def main(argv: Optional[List[str]] = None) -> int:
+    rospy.init_node("rubass", argv=argv, disable_signals=True)  # Monitor handles SIGINT/SIGTERM
+    keep_rosout_flag()  # no log call asks the master anything (one would block while its host is cut off)
+    sys.setswitchinterval(0.0005)  # a busy thread must not delay a deadline by the default 5 ms
+    try:
+        names = rospy.get_param_names()
+    except Exception:  # noqa: BLE001 - only a warning is lost; read_config says what is wrong
+        names = []
+    for warning in unknown_params(names, rospy.get_name()):  # a typo must not pass silently
+        rospy.logwarn("rubass: %s", warning)
+    state_file = default_path(os.environ.get("ROS_HOME"), rospy.get_name())
+    if rospy.get_name() == "/rubass":  # a plain rosrun was /rubass_monitor before version 2's last stop
+        old = default_path(os.environ.get("ROS_HOME"), "/rubass_monitor")
+        if adopt_old_default(state_file, old):
+            rospy.logwarn("rubass: latch state %s moved to %s (the node's new default name)", old, state_file)
+    try:
+        config = read_config(lambda name, default: rospy.get_param("~" + name, default), state_file)
+        monitor = Monitor(config)
+        monitor.setup()
+    except (ParamError, ConfigError) as exc:
+        rospy.logfatal("rubass: cannot start:\n%s", exc)  # on stderr and in rosout: printed once
+        rospy.signal_shutdown("cannot start")
+        return 1
+    monitor.run()
+    return 0
