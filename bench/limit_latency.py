@@ -52,6 +52,7 @@ def receiver(samples: int) -> None:
 
     rospy.init_node("receiver")
     lat = {name: [] for name in PATHS}
+    seen = {name: set() for name in PATHS}  # send stamps already received, per path
     wrong = []
     done = threading.Event()
 
@@ -62,6 +63,9 @@ def receiver(samples: int) -> None:
             return
         if msg.angular.y == 0.0:  # the limit's own zero command (none had come yet): not a sample
             return
+        if msg.angular.y in seen[name]:  # the limit repeating its latest command at its rate: not a sample
+            return
+        seen[name].add(msg.angular.y)
         lat[name].append(now - msg.angular.y)
         if name == "limit" and msg.linear.x != 0.2:
             wrong.append(msg.linear.x)
