@@ -60,10 +60,12 @@ def coverage(spec: CheckedSpec, outcomes: List[Outcome]) -> Coverage:
 
 
 def render(cov: Coverage) -> str:
+    from .results import shown_path  # results builds on this module
+
     def line(title: str, items: List[str]) -> str:
         return f"  {title}: {', '.join(items) if items else 'none'}"
 
-    return "\n".join([f"coverage of {cov.spec} ({cov.tests} test{'s' if cov.tests != 1 else ''}):",
+    return "\n".join([f"coverage of {shown_path(cov.spec)} ({cov.tests} test{'s' if cov.tests != 1 else ''}):",
                       line("rules never true", cov.rules_never_true),
                       line("behaviours never started", cov.behaviours_never_started),
                       line("ids no test covers", cov.ids_untested),

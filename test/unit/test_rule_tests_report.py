@@ -130,3 +130,11 @@ def test_shipped_example_tests_pass_with_full_coverage(capsys):
     out = capsys.readouterr().out
     assert code == 0, out
     assert out.count("rules never true: none") == 2 and out.count("ids no test covers: none") == 2
+
+
+def test_the_coverage_names_its_spec_as_the_docs_show(capsys, monkeypatch):
+    """docs/testing.md: `coverage of config/frobit.rbs (7 tests):`, relative to the current folder
+    (it printed the absolute path)."""
+    monkeypatch.chdir(ROOT)
+    assert main(["test", os.path.join("config", "tests", "frobit.test.yaml"), "--coverage"]) == 0
+    assert "coverage of config/frobit.rbs (7 tests):" in capsys.readouterr().out
