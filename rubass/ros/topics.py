@@ -51,12 +51,9 @@ class TopicState:
     scalar: FrozenSet[Tuple[ast.PathElem, ...]] = frozenset()  # paths the spec uses as one value
     implicit: FrozenSet[Tuple[ast.PathElem, ...]] = frozenset()  # header.stamp only for stamp_age(): unknown if absent
     needs: Dict[Tuple[ast.PathElem, ...], str] = field(default_factory=dict)  # path -> 'number' | 'condition'
-    type: str = ""
-    md5: str = ""
     messages: int = 0
     errors: List[str] = field(default_factory=list)
     subscriber: Optional[rospy.Subscriber] = None  # None until the registrar has made it
-    cls: Any = None
     # (md5, class, type) of the type evaluated, as one value: a callback of another publisher's
     # thread reads it in one step, never a class of one type beside the md5 of another
     decoder: Tuple[str, Any, str] = ("", None, "")
@@ -66,6 +63,19 @@ class TopicState:
     mixed: Optional[str] = None  # while publishers of two types are on: what is wrong (a data error)
     mixed_logged: float = float("-inf")
     checked: float = 0.0  # wall time the types were last looked at
+
+    @property
+    def md5(self) -> str:
+        return self.decoder[0]
+
+    @property
+    def cls(self) -> Any:
+        """The class of the type evaluated; None when it cannot be loaded (or none came yet)."""
+        return self.decoder[1]
+
+    @property
+    def type(self) -> str:
+        return self.decoder[2]
 
 
 class TopicWatcher:

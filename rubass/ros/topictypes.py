@@ -126,7 +126,6 @@ def over(state: Any, left: str) -> str:
 def adopt(state: Any, kind: Kind, log: Log, change: bool) -> None:
     """Evaluate `kind`'s messages from now on; a change of the only type is logged and kept."""
     old = state.type
-    state.type, state.md5, state.cls = kind.type, kind.md5, kind.cls
     state.decoder = (kind.md5, kind.cls, kind.type)  # one value: read by callbacks without the lock
     state.errors = ([] if kind.cls is not None else [f"cannot load message type {kind.type}"]) + list(kind.problems)
     if change and old and old != kind.type:
