@@ -282,13 +282,13 @@ class ActionRunner:
         gives the action back the failing state it had before (none, or another failure such as a
         limit's bad input), with the stuck call kept on record; then the call's own outcome counts."""
         with self._call_lock:
-            stuck, self._call, self._stuck = self._stuck, None, False
+            call, stuck, self._call, self._stuck = self._call, self._stuck, None, False
             if not stuck:
                 return
             text, (failing, error) = self.stats.last_error, self._before_stuck
             self.stats.failing = failing
             self.stats.last_error = error if failing else RESOLVED + text
-        self.log("info", f"action '{self.plugin.name}' {text.split(' has not', 1)[0]} returned (it was stuck)")
+        self.log("info", f"action '{self.plugin.name}' {call[0] if call else 'a call'} returned (it was stuck)")
 
     def _resolve(self, what: str) -> None:
         """A success after a failure: the error stays on record but no longer makes /diagnostics ERROR.
@@ -300,8 +300,7 @@ class ActionRunner:
             return
         self.stats.failing = ""
         self.stats.last_error = RESOLVED + error
-        if failed != "input":  # a plugin's own bad-input count is logged by the plugin
-            self.log("info", f"action '{self.plugin.name}' {what} succeeded after failing ({error})")
+        self.log("info", f"action '{self.plugin.name}' {what} succeeded after failing ({error})")
 
 
 class _Watchdog:
