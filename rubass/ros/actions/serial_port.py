@@ -10,8 +10,7 @@ from typing import Any, Optional
 import rospy
 import serial
 
-from ...actions.base import ActionPlugin, Context
-from ...actions.base import Skipped
+from ...actions.base import ActionPlugin, Context, Skipped
 
 REOPEN_PERIOD = 0.5
 

@@ -4,14 +4,13 @@ from __future__ import annotations
 
 import threading
 import time
-from typing import Any, Dict, List, Optional, Tuple
+from typing import Any, Dict, List, Tuple
 
 import rosgraph
 import roslib.message
 import rospy
 
-from ...actions.base import ActionPlugin, Context
-from ...actions.base import Skipped
+from ...actions.base import ActionPlugin, Context, Skipped
 from ..rpc import proxy
 from .publish import build_message, ros_class
 
@@ -30,31 +29,21 @@ class ServicePlugin(ActionPlugin):
         self.proxy = rospy.ServiceProxy(self.params["service"], cls)
         self.call_timeout = float(self.params["timeout"]) + 1.0  # the runner's stuck bound: the call and _advertised
 
-    @property
-    def _hung(self) -> Optional[Tuple[threading.Thread, float, List[str]]]:
-        return _HUNG.get(self.name)
-
-    @_hung.setter
-    def _hung(self, value: Optional[Tuple[threading.Thread, float, List[str]]]) -> None:
-        if value is None:
-            _HUNG.pop(self.name, None)
-        else:
-            _HUNG[self.name] = value
-
     def _previous_returned(self, phase: str) -> None:
         """Raise while the call abandoned last time is still in the service (a wait for the service
         that overran the timeout ends on its own within rospy's 0.3 s poll: waited for): a start or
         release fails at once, a hold (every tick) is skipped, not counted as another failure."""
-        if self._hung is None:
+        hung = _HUNG.get(self.name)
+        if hung is None:
             return
-        thread, since, stage = self._hung
+        thread, since, stage = hung
         if stage[0] == "waiting":
             thread.join(0.4)
         if thread.is_alive():
             text = (f"the previous call to {self.params['service']} has not returned after "
                     f"{time.monotonic() - since:.1f} s: not calling it again until it does")
             raise Skipped(text) if phase == "hold" else TimeoutError(text)
-        self._hung = None
+        _HUNG.pop(self.name, None)
 
     def _call(self, phase: str) -> None:
         """Call with a timeout; a call that hangs is abandoned (its thread is a daemon), and while it has
@@ -77,7 +66,7 @@ class ServicePlugin(ActionPlugin):
         started = time.monotonic()
         worker.join(timeout)
         if worker.is_alive():
-            self._hung = (worker, started, stage)
+            _HUNG[self.name] = (worker, started, stage)
         if not result or type(result[0]) is rospy.ROSException:  # timed out: waiting for it, or in the call
             if not self._advertised():  # asked only now, to say why
                 raise IOError(f"service {self.params['service']} does not exist (not advertised on the master)")
