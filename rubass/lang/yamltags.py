@@ -2,7 +2,7 @@
 custom '!tags'), so that a file is reported as an error rather than a loader traceback."""
 from __future__ import annotations
 
-from typing import AbstractSet, Any, Dict, List, Set, Tuple
+from typing import AbstractSet, Any, Dict, Iterator, List, Set, Tuple
 
 import yaml
 
@@ -11,21 +11,25 @@ PLAIN_TAGS = frozenset(_CORE + t for t in ("str", "int", "float", "bool", "null"
 SAFE_TAGS = PLAIN_TAGS | {_CORE + t for t in ("binary", "timestamp", "set", "omap", "pairs", "merge", "value")}
 
 
-def foreign_tags(root: yaml.Node, allowed: AbstractSet[str] = SAFE_TAGS) -> List[yaml.Node]:
-    """The nodes whose tag is not allowed, in file order; each node once (alias bombs are DAGs)."""
-    seen, out, todo = set(), [], [root]
+def nodes_once(root: yaml.Node) -> Iterator[yaml.Node]:
+    """Every node of a composed document, each once (alias bombs are DAGs); a node's children are
+    read after it is yielded, so a caller may rewrite a mapping's value (merge keys) on the way."""
+    seen, todo = set(), [root]
     while todo:
         node = todo.pop()
         if id(node) in seen:
             continue
         seen.add(id(node))
-        if node.tag not in allowed:
-            out.append(node)
+        yield node
         if isinstance(node, yaml.MappingNode):
             todo += [n for pair in node.value for n in pair]
         elif isinstance(node, yaml.SequenceNode):
             todo += list(node.value)
-    return sorted(out, key=lambda n: n.start_mark.index)
+
+
+def foreign_tags(root: yaml.Node, allowed: AbstractSet[str] = SAFE_TAGS) -> List[yaml.Node]:
+    """The nodes whose tag is not allowed, in file order."""
+    return sorted((n for n in nodes_once(root) if n.tag not in allowed), key=lambda n: n.start_mark.index)
 
 
 def plain_value(node: yaml.Node) -> Any:
@@ -52,17 +56,9 @@ def resolve_merges(root: yaml.Node) -> List[yaml.Node]:
     """
     bad: List[yaml.Node] = []
     done: Set[int] = set()
-    todo, visited = [root], set()
-    while todo:
-        node = todo.pop()
-        if id(node) in visited:
-            continue
-        visited.add(id(node))
+    for node in nodes_once(root):
         if isinstance(node, yaml.MappingNode):
             _merge(node, done, bad)
-            todo += [n for pair in node.value for n in pair]
-        elif isinstance(node, yaml.SequenceNode):
-            todo += list(node.value)
     return bad
 
 
@@ -99,23 +95,16 @@ def duplicate_keys(root: yaml.Node) -> List[Tuple[yaml.Node, yaml.Node, yaml.Nod
     file order (YAML loaders keep the last silently). Merge keys ('<<') are not counted: call
     this before resolve_merges. Each mapping is looked at once (alias bombs are DAGs)."""
     out: List[Tuple[yaml.Node, yaml.Node, yaml.Node]] = []
-    todo, visited = [root], set()
-    while todo:
-        node = todo.pop()
-        if id(node) in visited:
+    for node in nodes_once(root):
+        if not isinstance(node, yaml.MappingNode):
             continue
-        visited.add(id(node))
-        if isinstance(node, yaml.MappingNode):
-            first: Dict[Any, yaml.Node] = {}
-            for key, _ in node.value:
-                if not isinstance(key, yaml.ScalarNode) or key.tag == MERGE:
-                    continue
-                ident = (key.tag, key.value)
-                if ident in first:
-                    out.append((node, key, first[ident]))
-                else:
-                    first[ident] = key
-            todo += [n for pair in node.value for n in pair]
-        elif isinstance(node, yaml.SequenceNode):
-            todo += list(node.value)
+        first: Dict[Any, yaml.Node] = {}
+        for key, _ in node.value:
+            if not isinstance(key, yaml.ScalarNode) or key.tag == MERGE:
+                continue
+            ident = (key.tag, key.value)
+            if ident in first:
+                out.append((node, key, first[ident]))
+            else:
+                first[ident] = key
     return sorted(out, key=lambda t: t[1].start_mark.index)
