@@ -1,8 +1,6 @@
 """A serial board away while its action is active: the engine's holds (every tick) must not reopen
 the port every tick ("failed action attempts" grew ~50/s); reopening follows the documented 0.5 s,
 the away state is reported by periodic() twice a second, and the board gets its start when back."""
-import os
-import select
 import time
 
 import pytest
@@ -14,40 +12,9 @@ from rubass.actions.base import Context  # noqa: E402
 from rubass.actions.runner import ActionRunner  # noqa: E402
 from rubass.lang.library import ActionDef  # noqa: E402
 from rubass.ros.actions import serial_port  # noqa: E402
+from test_serial_reconnect import board  # noqa: E402,F401  (the fake board: a pty behind a symlink)
 
 CTX = Context(behaviour=1, line=3)
-
-
-class Board:
-    """A pty reached through a symlink (a udev /dev/serial/by-id/… link)."""
-
-    def __init__(self, link):
-        self.link, self.master, self.slave = link, None, None
-
-    def plug(self):
-        self.master, self.slave = os.openpty()
-        os.symlink(os.ttyname(self.slave), self.link)
-
-    def unplug(self):
-        if self.master is not None:
-            os.close(self.master)
-            os.close(self.slave)
-            os.unlink(self.link)
-            self.master = None
-
-    def read(self, seconds):
-        got, end = b"", time.monotonic() + seconds
-        while time.monotonic() < end:
-            if select.select([self.master], [], [], 0.05)[0]:
-                got += os.read(self.master, 100)
-        return got
-
-
-@pytest.fixture
-def board(tmp_path):
-    b = Board(str(tmp_path / "ttyBOARD"))
-    yield b
-    b.unplug()
 
 
 @pytest.fixture
