@@ -69,8 +69,15 @@ def test_sigterm_exits_while_a_subscription_waits_for_the_master(ros, tmp_path):
     The monitor releases its actions, then exits 0 within a few seconds whatever rospy waits for."""
     import time
 
+    import rosgraph
+
     path = spec(tmp_path, FAST)
     mon = ros.monitor(path)
+    master = rosgraph.Master("/t", master_uri=ros.env["ROS_MASTER_URI"])
+    end = time.monotonic() + 10
+    while time.monotonic() < end and not any(t == "/cmd_vel" and "/rubass" in who
+                                             for t, who in master.getSystemState()[1]):
+        time.sleep(0.05)  # its first subscription made: only the reload's new one waits for the master
     ros.master.stop()
     with open(path, "a") as fh:
         fh.write(NEW)
