@@ -114,3 +114,55 @@ def parse_quantity(text: str) -> Optional[Tuple[float, Dimension]]:
     if unit is None:
         return None
     return value * unit[0], unit[1]
+
+
+# other spellings of units, to suggest the unit itself ('sec' is a unit too, but 'm/sec' is not)
+_SPELLINGS = {"sec": "s", "secs": "s", "second": "s", "seconds": "s", "msec": "ms", "hr": "h", "hrs": "h",
+              "hour": "h", "hours": "h", "meter": "m", "meters": "m", "metre": "m", "metres": "m",
+              "degree": "deg", "degrees": "deg", "radian": "rad", "radians": "rad", "hz": "Hz", "mins": "min",
+              "mps": "m/s", "kph": "km/h", "kmh": "km/h"}
+
+
+def _unit_part(text: str) -> Optional[Tuple[float, Dimension]]:
+    """'sec' or 's^2' (a part of a compound unit) -> (factor, dimension), None when unknown."""
+    name, _, power = text.partition("^")
+    if power and not power.isdigit():
+        return None
+    name = _SPELLINGS.get(name, _SPELLINGS.get(name.lower(), name))
+    if "/" in name or name not in UNITS:
+        return None
+    factor, d = UNITS[name]
+    n = int(power) if power else 1
+    return factor ** n, tuple((b, e * n) for b, e in d)
+
+
+def _compound(unit: str) -> Optional[Tuple[float, Dimension]]:
+    """'m/sec' -> the factor and dimension it means, None when a part is unknown."""
+    parts = unit.split("/")
+    if len(parts) != 2:
+        return None
+    top, bottom = _unit_part(parts[0]), _unit_part(parts[1])
+    if top is None or bottom is None:
+        return None
+    return top[0] / bottom[0], dim_mul(top[1], bottom[1], -1)
+
+
+def unit_suggestion(unit: str) -> str:
+    """A suggestion suffix for an unknown unit, as errors.did_you_mean gives one ('' when nothing is
+    close). A compound unit is suggested whole: 'm/sec' -> 'm/s', not the 'sec' a spelling match finds."""
+    import difflib
+
+    meant = _compound(unit) if "/" in unit else None
+    if meant is not None:
+        same = [u for u, (f, d) in UNITS.items() if d == meant[1]]
+        exact = [u for u in same if abs(UNITS[u][0] - meant[0]) <= 1e-9 * meant[0]]
+        if exact:
+            return f"; did you mean '{exact[0]}'?"
+        if same:
+            return f"; a {dimension_name(meant[1])} is written in {', '.join(same)}"
+    alone = _SPELLINGS.get(unit, _SPELLINGS.get(unit.lower()))
+    if alone is not None:
+        return f"; did you mean '{alone}'?"
+    pool = sorted(u for u in UNITS if ("/" in u) == ("/" in unit)) or sorted(UNITS)
+    close = difflib.get_close_matches(unit, pool, n=1, cutoff=0.6)
+    return f"; did you mean '{close[0]}'?" if close else ""

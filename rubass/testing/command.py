@@ -56,10 +56,12 @@ def run(args: argparse.Namespace) -> int:
             print(render(coverage(spec, [o for r in rs for o in r.outcomes])))
     junit_error = ""
     if args.junit:
-        from .junit import write_junit
+        from .junit import FolderError, write_junit
 
         try:
             write_junit(results, args.junit)
+        except FolderError as exc:
+            junit_error = f"rubass test: error: cannot write {args.junit}: {exc}"
         except OSError as exc:
             junit_error = f"rubass test: error: cannot write {args.junit}: {exc.strerror or exc}"
     print(f"{passed} passed, {failed} failed")  # the last line, even when the XML could not be written

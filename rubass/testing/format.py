@@ -4,11 +4,11 @@ from __future__ import annotations
 import math
 import os
 from dataclasses import dataclass, field
-from typing import Any, Dict, List, Optional, Tuple
+from typing import Any, Callable, Dict, List, Optional, Tuple, TypeVar
 
 from ..lang.errors import did_you_mean
 from ..lang.units import MEMORY, TIME, FREQUENCY, parse_quantity
-from .messages import MessageError, Path, field_info, fields_of, message_class, parse_path
+from .messages import MessageError, NoRosPython, Path, field_info, fields_of, message_class, parse_path
 from .series import GAP, UNKNOWN, SeriesError, expand
 from .yamlpos import LDict, LList, TestFileError, load
 
@@ -16,6 +16,7 @@ UNSET: Any = object()  # a node-sample value the sample leaves out
 DEFAULT_TOLERANCE = 1e-3
 MAX_TIME = 24 * 3600.0  # a test simulates at most a day (ticks at 50 Hz: 4.3 million)
 MAX_MESSAGES = 1_000_000  # per test: each is a real message object
+T = TypeVar("T")
 
 
 @dataclass
@@ -69,6 +70,7 @@ class Case:
     nodes: List[NodeSampleInput] = field(default_factory=list)
     expects: List[Expect] = field(default_factory=list)
     covers_lines: List[int] = field(default_factory=list)  # the line of each `covers` value
+    readable: bool = True  # False: an error in its inputs or expectations (reported): it cannot run
 
     @property
     def end(self) -> float:
@@ -88,6 +90,7 @@ class TestFile:
     actions: List[str]
     cases: List[Case]
     model: Any = None  # the system model (rubass.lang.sysmodel.SystemModel) named by `model:`, if any
+    errors: List[TestFileError] = field(default_factory=list)  # every error found, in the file's order
 
 
 class _Reader:
@@ -95,17 +98,29 @@ class _Reader:
         self.path = path
         self.registry: Any = None  # message definitions of the system model, when the file names one
         self.sysmodel: Any = None  # the system model itself (its unit tables)
+        self.errors: List[TestFileError] = []
 
-    def fail(self, line: int, message: str) -> TestFileError:
-        return TestFileError(self.path, line, message)
+    def fail(self, line: int, message: str, fatal: bool = False) -> TestFileError:
+        return TestFileError(self.path, line, message, fatal)
+
+    def guard(self, default: T, read: Callable[..., T], *args: Any) -> T:
+        """read(*args), or `default` when it fails: its error is kept and reading goes on, so that
+        one run reports every error of the file (a fatal one still stops the file)."""
+        try:
+            return read(*args)
+        except TestFileError as exc:
+            if exc.fatal:
+                raise
+            self.errors.append(exc)
+            return default
 
     def mapping(self, value: Any, line: int, what: str, keys: Tuple[str, ...], required: Tuple[str, ...] = ()) -> LDict:
         if not isinstance(value, LDict):
             raise self.fail(line, f"{what} must be a mapping")
         for k in value:
-            if k not in keys:
-                raise self.fail(value.key_at(k), f"unknown key '{k}' in {what}{did_you_mean(str(k), keys)}"
-                                              f" (keys: {', '.join(keys)})")
+            if k not in keys:  # left out, and reading goes on
+                self.errors.append(self.fail(value.key_at(k), f"unknown key '{k}' in {what}"
+                                                              f"{did_you_mean(str(k), keys)} (keys: {', '.join(keys)})"))
         for k in required:
             if k not in value:
                 raise self.fail(value.line, f"{what} needs '{k}'")
@@ -143,24 +158,31 @@ class _Reader:
         top = self.mapping(doc, 1, "a test file", ("spec", "actions", "model", "tests"), ("spec", "tests"))
         spec = top["spec"]
         if not isinstance(spec, str) or not spec:
-            raise self.fail(top.at("spec"), "spec must be the path of a .rbs file")
+            self.errors.append(self.fail(top.at("spec"), "spec must be the path of a .rbs file"))
+            spec = ""
         base = os.path.dirname(os.path.abspath(self.path))
-        listed = top.get("actions", LList())
-        listed = [listed] if isinstance(listed, str) else self.seq(listed, top.at("actions"), "actions")
-        actions = [os.path.join(base, str(a)) for a in listed]
-        model = self.model(top, base) if "model" in top else None
+        actions = self.guard([], self.actions, top, base)
+        model = self.guard(None, self.model, top, base) if "model" in top else None
         self.registry = model.registry if model is not None else None
         self.sysmodel = model
-        tests = self.seq(top["tests"], top.at("tests"), "tests")
-        if not tests:
-            raise self.fail(top.at("tests"), "tests is empty: a file needs at least one test")
-        cases = [self.case(t, tests.at(i), i) for i, t in enumerate(tests)]
+        tests = self.guard(LList(), self.seq, top["tests"], top.at("tests"), "tests")
+        if not tests and isinstance(top["tests"], LList):
+            self.errors.append(self.fail(top.at("tests"), "tests is empty: a file needs at least one test"))
+        cases = [c for c in (self.guard(None, self.case, t, tests.at(i), i) for i, t in enumerate(tests)) if c]
         seen: Dict[str, int] = {}
         for c in cases:
             if c.name in seen:
-                raise self.fail(c.line, f"a second test named '{c.name}' (the first is at line {seen[c.name]})")
-            seen[c.name] = c.line
-        return TestFile(self.path, os.path.normpath(os.path.join(base, spec)), top.at("spec"), actions, cases, model)
+                self.errors.append(self.fail(c.line, f"a second test named '{c.name}' (the first is at line "
+                                                     f"{seen[c.name]})"))
+            seen.setdefault(c.name, c.line)
+        spec_path = os.path.normpath(os.path.join(base, spec)) if spec else ""
+        errors = sorted(self.errors, key=lambda e: e.line)  # stable: one line's errors as found
+        return TestFile(self.path, spec_path, top.at("spec"), actions, cases, model, errors)
+
+    def actions(self, top: LDict, base: str) -> List[str]:
+        listed = top.get("actions", LList())
+        listed = [listed] if isinstance(listed, str) else self.seq(listed, top.at("actions"), "actions")
+        return [os.path.join(base, str(a)) for a in listed]
 
     def model(self, top: LDict, base: str) -> Any:
         """The system model file named by `model:` (relative to the test file)."""
@@ -180,22 +202,28 @@ class _Reader:
     def case(self, value: Any, line: int, i: int) -> Case:
         t = self.mapping(value, line, "a test", ("name", "covers", "duration", "topics", "nodes", "expect",
                                                  "tolerance"))
+        before = len(self.errors)
         name = str(t.get("name", f"test {i + 1}"))
-        covers, covers_lines = self.covers(t)
-        duration = self.time(t["duration"], t.at("duration"), "duration") if "duration" in t else None
-        tol = self.time(t["tolerance"], t.at("tolerance"), "tolerance") if "tolerance" in t else DEFAULT_TOLERANCE
+        covers, covers_lines = self.guard(([], []), self.covers, t)
+        duration = self.guard(None, self.time, t["duration"], t.at("duration"), "duration") if "duration" in t else None
+        tol = self.guard(DEFAULT_TOLERANCE, self.time, t["tolerance"], t.at("tolerance"), "tolerance") \
+            if "tolerance" in t else DEFAULT_TOLERANCE
         case = Case(name, t.line, covers, duration, tol, covers_lines=covers_lines)
-        topics = self.mapping(t.get("topics", LDict()), t.at("topics"), "topics", tuple(t.get("topics") or ()))
+        topics = self.guard(LDict(), self.mapping, t.get("topics", LDict()), t.at("topics"), "topics",
+                            tuple(t.get("topics") or ()) if isinstance(t.get("topics"), dict) else ())
         for topic, spec in topics.items():
-            self.topic(case, str(topic), spec, topics.at(topic))
-        nodes = self.mapping(t.get("nodes", LDict()), t.at("nodes"), "nodes", tuple(t.get("nodes") or ()))
+            self.guard(None, self.topic, case, str(topic), spec, topics.at(topic))
+        nodes = self.guard(LDict(), self.mapping, t.get("nodes", LDict()), t.at("nodes"), "nodes",
+                           tuple(t.get("nodes") or ()) if isinstance(t.get("nodes"), dict) else ())
         for node, samples in nodes.items():
-            self.node(case, str(node), samples, nodes.at(node))
-        expects = self.seq(t.get("expect", LList()), t.at("expect"), "expect")
-        case.expects = [self.expect(e, expects.at(k)) for k, e in enumerate(expects)]
+            self.guard(None, self.node, case, str(node), samples, nodes.at(node))
+        expects = self.guard(LList(), self.seq, t.get("expect", LList()), t.at("expect"), "expect")
+        read = [self.guard(None, self.expect, e, expects.at(k)) for k, e in enumerate(expects)]
+        case.expects = [e for e in read if e is not None]
         if duration is not None:
             for e in case.expects:
-                self.within_duration(e, duration, e.tolerance if e.tolerance is not None else tol)
+                self.guard(None, self.within_duration, e, duration, e.tolerance if e.tolerance is not None else tol)
+        case.readable = len(self.errors) == before
         return case
 
     def covers(self, t: LDict) -> Tuple[List[str], List[int]]:
@@ -229,6 +257,8 @@ class _Reader:
                                                          "messages"), ("type",))
         try:
             cls = message_class(t["type"], self.registry)
+        except NoRosPython as exc:  # no type can be had here: said once, for the whole file
+            raise self.fail(t.at("type"), str(exc), fatal=True) from None
         except MessageError as exc:
             raise self.fail(t.at("type"), str(exc)) from None
         before = case.topics.get(topic)
@@ -238,11 +268,11 @@ class _Reader:
         case.topics[topic] = TopicInput(topic, t["type"], cls, line)
         series = [k for k in ("field", "fields", "values", "rate") if k in t]
         if series:
-            self.series(case, topic, t)
+            self.guard(None, self.series, case, topic, t)
         if "messages" in t:
             msgs = self.seq(t["messages"], t.at("messages"), f"messages of {topic}")
             for k, m in enumerate(msgs):
-                self.message(case, topic, m, msgs.at(k))
+                self.guard(None, self.message, case, topic, m, msgs.at(k))
         if not series and "messages" not in t:
             raise self.fail(line, f"topic {topic} has no input: give a series (rate, field, values) or messages")
 
@@ -332,18 +362,21 @@ class _Reader:
     def node(self, case: Case, node: str, value: Any, line: int) -> None:
         samples = self.seq(value, line, f"the samples of node {node}")
         for k, s in enumerate(samples):
-            s = self.mapping(s, samples.at(k), f"a sample of node {node}", ("at", "alive", "cpu", "memory"), ("at",))
-            alive = s.get("alive", UNSET)
-            if alive is not UNSET and alive is not None and not isinstance(alive, bool):
-                raise self.fail(s.at("alive"), f"alive must be true or false, not {alive!r}")
-            cpu = s.get("cpu", UNSET)
-            if cpu is not UNSET and cpu is not None:
-                cpu = self.quantity(cpu, s.at("cpu"), "cpu", (), "a share of one core (0.5 or 50 %)")
-            mem = s.get("memory", UNSET)
-            if mem is not UNSET and mem is not None:
-                mem = self.quantity(mem, s.at("memory"), "memory", MEMORY, "bytes (or 50 MB)")
-            at = self.time(s["at"], s.at("at"), "at")
-            case.nodes.append(NodeSampleInput(node, at, alive, cpu, mem, samples.at(k)))
+            self.guard(None, self.sample, case, node, s, samples.at(k))
+
+    def sample(self, case: Case, node: str, value: Any, line: int) -> None:
+        s = self.mapping(value, line, f"a sample of node {node}", ("at", "alive", "cpu", "memory"), ("at",))
+        alive = s.get("alive", UNSET)
+        if alive is not UNSET and alive is not None and not isinstance(alive, bool):
+            raise self.fail(s.at("alive"), f"alive must be true or false, not {alive!r}")
+        cpu = s.get("cpu", UNSET)
+        if cpu is not UNSET and cpu is not None:
+            cpu = self.quantity(cpu, s.at("cpu"), "cpu", (), "a share of one core (0.5 or 50 %)")
+        mem = s.get("memory", UNSET)
+        if mem is not UNSET and mem is not None:
+            mem = self.quantity(mem, s.at("memory"), "memory", MEMORY, "bytes (or 50 MB)")
+        at = self.time(s["at"], s.at("at"), "at")
+        case.nodes.append(NodeSampleInput(node, at, alive, cpu, mem, line))
 
     def expect(self, value: Any, line: int) -> Expect:
         e = self.mapping(value, line, "an expectation", ("at", "start", "release", "never", "active", "from", "to",
@@ -379,5 +412,6 @@ def _path_text(path: Path) -> str:
 
 
 def read_test_file(path: str) -> TestFile:
-    """The test file at `path`, or TestFileError with the place."""
+    """The test file at `path` with every error found in it (`errors`), or TestFileError when it
+    cannot be read at all (not YAML, not a mapping, no spec or tests, no ROS Python here)."""
     return _Reader(path).read()

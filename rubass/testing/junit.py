@@ -59,4 +59,20 @@ def write_junit(results: List[FileResult], path: str) -> None:
     root.set("failures", str(failures))
     root.set("errors", str(errors))
     tree = ET.ElementTree(root)
+    make_parent(path)
     tree.write(path, encoding="utf-8", xml_declaration=True)
+
+
+class FolderError(OSError):
+    """The folder an output file goes in cannot be made; str() says which and why."""
+
+
+def make_parent(path: str) -> None:
+    """Create the folders `path` goes in (`out/` of `--junit out/tests.xml`); FolderError when one cannot be."""
+    folder = os.path.dirname(path)
+    if not folder or os.path.isdir(folder):
+        return
+    try:
+        os.makedirs(folder, exist_ok=True)
+    except OSError as exc:
+        raise FolderError(f"cannot create the folder {folder}: {exc.strerror or exc}") from None

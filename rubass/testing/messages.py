@@ -5,12 +5,14 @@ for a number or a fraction for an integer is a MessageError saying which field a
 """
 from __future__ import annotations
 
+import importlib
 import io
 import math
 import re
+import sys
 from typing import Any, Dict, List, Optional, Tuple
 
-from ..lang.errors import RubassError
+from ..lang.errors import RubassError, did_you_mean
 
 _ARRAY = re.compile(r"(.*)\[(\d*)\]$")
 _INTS = {"int8", "uint8", "int16", "uint16", "int32", "uint32", "int64", "uint64", "char", "byte"}
@@ -25,7 +27,22 @@ class MessageError(RubassError, ValueError):
     """A type that is not installed, or a field or value the type does not allow."""
 
 
+class NoRosPython(MessageError):
+    """This interpreter cannot import ROS 1's Python message support (genpy, roslib): no type can be built."""
+
+
 _DYNAMIC: Dict[str, Any] = {}  # classes built from system models, by type name
+
+
+def _ros_python(type_name: str) -> None:
+    """NoRosPython when genpy or roslib cannot be imported at all (the python3 first on PATH has no ROS):
+    then no type is installed as far as this interpreter can tell, and saying so would mislead."""
+    try:
+        for module in ("genpy", "roslib.message"):
+            importlib.import_module(module)
+    except ImportError as exc:
+        raise NoRosPython(f"message type {type_name} needs ROS 1's Python message support, which this interpreter "
+                          f"({sys.executable}) cannot import ({exc}): run rubass with /usr/bin/python3") from None
 
 
 def model_class(type_name: str, registry: Any) -> Any:
@@ -64,6 +81,7 @@ def message_class(type_name: Any, registry: Any = None) -> Any:
     (`registry`: a rubass.lang.msgdef.Registry), or MessageError."""
     if not isinstance(type_name, str) or not re.fullmatch(r"[A-Za-z_][\w]*/[A-Za-z_]\w*", type_name):
         raise MessageError(f"'{type_name}' is not a message type (pkg/Name, e.g. nav_msgs/Odometry)")
+    _ros_python(type_name)
     cls = _installed(type_name)
     if cls is None:
         cls = model_class(type_name, registry)
@@ -96,11 +114,12 @@ def _text(path: Path) -> str:
     return "".join(f"[{p}]" if isinstance(p, int) else f".{p}" for p in path).lstrip(".")
 
 
-def _slot_type(obj: Any, name: str, done: Path) -> str:
+def _slot_type(obj: Any, name: str, done: Path, within: str = "") -> str:
+    """The type of field `name` of `obj` (reached by `done`, or written `within` in a mapping)."""
     slots = list(getattr(obj, "__slots__", ()))
     if name not in slots:
-        where = f"'{_text(done)}' ({obj._type})" if done else obj._type
-        raise MessageError(f"{where} has no field '{name}' (fields: {', '.join(slots)})")
+        where = f"'{within or _text(done)}' ({obj._type})" if done or within else obj._type
+        raise MessageError(f"{where} has no field '{name}'{did_you_mean(name, slots)} (fields: {', '.join(slots)})")
     return obj._slot_types[slots.index(name)]
 
 
@@ -110,18 +129,23 @@ def _nested_class(type_name: str) -> Any:
     return _DYNAMIC.get(type_name) or message_class(type_name)
 
 
+def _a(slot: str) -> str:
+    """'an int8', 'a float64', 'a uint8': the type with its article."""
+    return f"{'an' if slot[:1] in 'aeio' else 'a'} {slot}"
+
+
 def _scalar(slot: str, value: Any, where: str) -> Any:
     if slot in _FLOATS:
         if isinstance(value, str) and value.strip().lower() in _NON_FINITE:  # as in series (TESTING.md)
             return float(value.strip().lower())
         if isinstance(value, bool) or not isinstance(value, (int, float)):
-            raise MessageError(f"{where} is a {slot}: {value!r} is not a number")
+            raise MessageError(f"{where} is {_a(slot)}: {value!r} is not a number")
         return float(value)
     if slot in _INTS:
         if isinstance(value, float) and value.is_integer():
             value = int(value)
         if isinstance(value, bool) or not isinstance(value, int):
-            raise MessageError(f"{where} is a {slot}: {value!r} is not an integer")
+            raise MessageError(f"{where} is {_a(slot)}: {value!r} is not an integer")
         return value
     if slot == "bool":
         if value in (0, 1) and not isinstance(value, bool):
@@ -137,12 +161,12 @@ def _scalar(slot: str, value: Any, where: str) -> Any:
         import genpy
 
         if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
-            raise MessageError(f"{where} is a {slot}: {value!r} is not a number of seconds")
+            raise MessageError(f"{where} is {_a(slot)}: {value!r} is not a number of seconds")
         try:
             return (genpy.Time if slot == "time" else genpy.Duration).from_sec(float(value)) if value else \
                 (genpy.Time() if slot == "time" else genpy.Duration())
         except (TypeError, ValueError, OverflowError) as exc:  # e.g. a negative time
-            raise MessageError(f"{where} is a {slot}: {value!r} cannot be one ({exc})") from None
+            raise MessageError(f"{where} is {_a(slot)}: {value!r} cannot be one ({exc})") from None
     return None  # a message: handled by the caller
 
 
@@ -163,7 +187,7 @@ def convert(slot: str, value: Any, where: str, current: Any = None) -> Any:
         raise MessageError(f"{where} is a message ({slot}): give its fields as a mapping")
     obj = current if current is not None else _nested_class(slot)()
     for k, v in value.items():
-        setattr(obj, str(k), convert(_slot_type(obj, str(k), ()), v, f"{where}.{k}", getattr(obj, str(k), None)
+        setattr(obj, str(k), convert(_slot_type(obj, str(k), (), where), v, f"{where}.{k}", getattr(obj, str(k), None)
                                      if str(k) in obj.__slots__ else None))
     return obj
 
@@ -183,7 +207,7 @@ def assign(msg: Any, path: Path, value: Any) -> None:
             continue
         slot = _slot_type(obj, elem, done)
         if last:
-            setattr(obj, elem, convert(slot, value, f"'{_text(path)}'", getattr(obj, elem)))
+            setattr(obj, elem, convert(slot, value, _text(path), getattr(obj, elem)))
             return
         child = getattr(obj, elem)
         if isinstance(child, (bytes, tuple)):

@@ -4,13 +4,15 @@ from __future__ import annotations
 import os
 import time
 from dataclasses import dataclass, field
-from typing import List, Optional, Sequence
+from typing import Dict, List, Optional, Sequence
 
 from ..lang import SpecError, load_spec
+from ..lang.errors import did_you_mean
 from ..lang.model import CheckedSpec
-from .coverage import unknown_covers
-from .format import read_test_file
-from .runner import Outcome, execute, prepare
+from .coverage import traced, unknown_covers
+from .declared import declared_model
+from .format import TestFile, read_test_file
+from .runner import Outcome, execute, prepare_all
 from .yamlpos import TestFileError
 
 
@@ -25,25 +27,26 @@ class FileResult:
 
 
 def run_file(path: str, extra_actions: Sequence[str] = ()) -> FileResult:
-    """Every test of one file; on an error none of its tests runs and `error` says where."""
+    """Every test of one file; on errors none of its tests runs and `error` gives every one of them,
+    in line order (`FILE:LINE: error: …` each)."""
     result = FileResult(path)
     try:
         tf = read_test_file(path)
+        errors: List[TestFileError] = list(tf.errors)
         result.spec_path = tf.spec
-        try:
-            spec = load_spec(tf.spec, list(tf.actions) + list(extra_actions), model=tf.model)
-        except SpecError as exc:
-            raise TestFileError(path, tf.spec_line, f"spec {tf.spec} cannot be used:\n{exc.render()}") from None
+        spec = _load_spec(tf, list(tf.actions) + list(extra_actions), errors) if tf.spec else None
         result.spec = spec
-        prepared = [prepare(spec, c, path, result.warnings) for c in tf.cases]
-        for c in tf.cases:
-            unknown = set(unknown_covers(spec, c.covers))
-            for k, name in enumerate(c.covers):
-                if name in unknown:
-                    line = c.covers_lines[k] if k < len(c.covers_lines) else c.line
-                    result.warnings.append(f"{path}:{line}: warning: test '{c.name}' covers '{name}', "
-                                           f"which is no @id or @hazard of the spec")
-    except TestFileError as exc:
+        prepared = []
+        if spec is not None:
+            for c in tf.cases:
+                p = prepare_all(spec, c, path, result.warnings, errors)
+                if p is not None:
+                    prepared.append(p)
+            result.warnings += _unknown_covers(spec, tf, path)
+        if errors:
+            result.error = "\n".join(_rendered(errors))
+            return result
+    except TestFileError as exc:  # the file cannot be read at all
         result.error = exc.render()
         return result
     except Exception as exc:  # a bug must not hide the other files' results behind a traceback
@@ -59,6 +62,51 @@ def run_file(path: str, extra_actions: Sequence[str] = ()) -> FileResult:
         outcome.elapsed = time.perf_counter() - t0
         result.outcomes.append(outcome)
     return result
+
+
+def _rendered(errors: List[TestFileError]) -> List[str]:
+    """The first error of each line, in line order (a second one at a line mostly follows from the first:
+    `{at: 2 s, strat: x}` lacks a start because of its typo)."""
+    out: Dict[int, str] = {}
+    for e in sorted(errors, key=lambda e: e.line):
+        out.setdefault(e.line, e.render())
+    return list(out.values())
+
+
+def _load_spec(tf: TestFile, actions: List[str], errors: List[TestFileError]) -> Optional[CheckedSpec]:
+    """The spec to run (checked against the file's `model:` when it names one), then checked against the
+    types the file's topics declare, with their standard units, as `rubass replay` checks it against a
+    recording's (the spec that runs is the one the monitor would run); its errors as one error at the
+    `spec:` line."""
+    model = declared_model(tf)
+    try:
+        spec = load_spec(tf.spec, actions, model=model if tf.model is not None else None)
+        if model is not None and tf.model is None:
+            try:
+                load_spec(tf.spec, actions, model=model)
+            except SpecError as exc:
+                why = "does not fit the types of the topics this file declares (as `rubass check --bag` says of a " \
+                      "recording of them)"
+                errors.append(TestFileError(tf.path, tf.spec_line, f"spec {tf.spec} {why}:\n{exc.render()}"))
+                return None
+        return spec
+    except SpecError as exc:
+        errors.append(TestFileError(tf.path, tf.spec_line, f"spec {tf.spec} cannot be used:\n{exc.render()}"))
+        return None
+
+
+def _unknown_covers(spec: CheckedSpec, tf: TestFile, path: str) -> List[str]:
+    """A warning for each `covers` value that is no @id or @hazard of the spec, with the closest one."""
+    ids, hazards = traced(spec)
+    out = []
+    for c in tf.cases:
+        unknown = set(unknown_covers(spec, c.covers))
+        for k, name in enumerate(c.covers):
+            if name in unknown:
+                line = c.covers_lines[k] if k < len(c.covers_lines) else c.line
+                out.append(f"{path}:{line}: warning: test '{c.name}' covers '{name}', which is no @id or @hazard "
+                           f"of the spec{did_you_mean(name, ids + hazards)}")
+    return out
 
 
 def shown_path(path: str) -> str:

@@ -71,8 +71,20 @@ def _test_time(fpath: Tuple[Any, ...], value: Any) -> Any:
     return value
 
 
-def _stream(spec: CheckedSpec, case: Case, path: str, warnings: List[str]) -> List[Tuple[float, str, Any]]:
+def _stream(spec: CheckedSpec, case: Case, path: str, warnings: List[str],
+            errors: Optional[List[TestFileError]] = None) -> List[Tuple[float, str, Any]]:
+    """The test's inputs as a recording. An error raises TestFileError, or with `errors` is kept there
+    (the first at each line: a series gives one error, not one per step) and the rest is still checked."""
     from ..ros.msgtypes import check_path
+
+    lines: Set[int] = set()
+
+    def fail(err: TestFileError) -> None:
+        if errors is None:
+            raise err
+        if err.line not in lines:
+            lines.add(err.line)
+            errors.append(err)
 
     names = spellings(spec.topics)  # resolved -> every spelling of it in the spec, each fed every message
     end = case.end
@@ -91,8 +103,8 @@ def _stream(spec: CheckedSpec, case: Case, path: str, warnings: List[str]) -> Li
             problem = check_path(t.cls, tuple(plain))
             if problem:
                 text = path_suffix(fpath)
-                raise TestFileError(path, t.line, f"{' and '.join(owners)} reads {topic}{text}, but in "
-                                                  f"{t.type_name}: {problem}")
+                fail(TestFileError(path, t.line, f"{' and '.join(owners)} reads {topic}{text}, but in "
+                                                 f"{t.type_name}: {problem}"))
     groups: Dict[Tuple[float, str], List[MessageInput]] = {}
     for m in case.messages:
         if m.time > end:
@@ -107,17 +119,22 @@ def _stream(spec: CheckedSpec, case: Case, path: str, warnings: List[str]) -> Li
                 assign(msg, ("header", "stamp"), EPOCH + time)
         except MessageError:
             pass
+        broken = False
         for part in sorted(parts, key=lambda part: part.line):  # the later entry in the file wins per field
             try:
                 for fpath, value in part.assignments:
                     assign(msg, fpath, _test_time(fpath, value))
             except MessageError as exc:
-                raise TestFileError(path, part.line, f"{topic} ({case.topics[topic].type_name}): {exc}") from None
+                fail(TestFileError(path, part.line, f"{topic} ({case.topics[topic].type_name}): {exc}"))
+                broken = True
+        if broken:
+            continue
         try:
             msg.serialize(io.BytesIO())  # what a publisher would send: catches what the setters could not
         except Exception as exc:  # genpy raises SerializationError, struct.error, TypeError…
-            raise TestFileError(path, parts[0].line, f"the message of {topic} at {time:g} s does not fit "
-                                                     f"{case.topics[topic].type_name}: {exc}") from None
+            fail(TestFileError(path, parts[0].line, f"the message of {topic} at {time:g} s does not fit "
+                                                    f"{case.topics[topic].type_name}: {exc}"))
+            continue
         for name in names.get(topic, ()):
             out.append((EPOCH + time, 0, name, msg))
     state: Dict[str, Dict[str, Any]] = {}
@@ -223,6 +240,25 @@ def prepare(spec: CheckedSpec, case: Case, path: str, warnings: List[str]) -> Pr
     resolver = Resolver(spec)
     targets = [(e, resolver.resolve(e.name, path, e.line)) for e in case.expects]
     return Prepared(spec, case, _stream(spec, case, path, warnings), targets)
+
+
+def prepare_all(spec: CheckedSpec, case: Case, path: str, warnings: List[str],
+                errors: List[TestFileError]) -> Optional[Prepared]:
+    """prepare(), keeping every error (each expectation's name, then the inputs) in `errors` rather than
+    stopping at the first; None when the test cannot run. The inputs of a test that had errors in the
+    file are not built (what is left of them would only give errors that follow from the first)."""
+    resolver = Resolver(spec)
+    before = len(errors)
+    targets = []
+    for e in case.expects:
+        try:
+            targets.append((e, resolver.resolve(e.name, path, e.line)))
+        except TestFileError as exc:
+            errors.append(exc)
+    if not case.readable:
+        return None
+    stream = _stream(spec, case, path, warnings, errors)
+    return Prepared(spec, case, stream, targets) if len(errors) == before else None
 
 
 def run_case(spec: CheckedSpec, case: Case, path: str, warnings: Optional[List[str]] = None) -> Outcome:

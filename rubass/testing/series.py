@@ -10,7 +10,7 @@ import re
 from typing import Any, List
 
 from ..lang.errors import RubassError
-from ..lang.units import UNITS, dimension_name
+from ..lang.units import UNITS, dimension_name, unit_suggestion
 
 GAP: Any = object()  # a step with no message
 
@@ -57,7 +57,9 @@ def value(word: str, field_dim: Any = UNKNOWN, field: str = "the field") -> Any:
     if unit not in UNITS:
         hint = f" (units of a {dimension_name(field_dim)}: {_units_of(field_dim)})" if known and _units_of(field_dim) \
             else ""
-        raise SeriesError(f"'{word}': '{unit}' is not a unit rubass knows{hint}")
+        meant = unit_suggestion(unit)
+        meant = meant if meant.startswith("; did you mean") else ""
+        raise SeriesError(f"'{word}': '{unit}' is not a unit rubass knows{meant}{hint}")
     factor, udim = UNITS[unit]
     if known and udim != field_dim:
         raise SeriesError(f"'{word}' is a {dimension_name(udim)} ({unit}), but {field} is a "

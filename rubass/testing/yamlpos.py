@@ -11,9 +11,10 @@ from ..lang.errors import RubassError
 class TestFileError(RubassError):
     """A test file that cannot be run; rendered `FILE:LINE: error: MESSAGE`."""
 
-    def __init__(self, path: str, line: int, message: str) -> None:
+    def __init__(self, path: str, line: int, message: str, fatal: bool = False) -> None:
         super().__init__(message)
         self.path, self.line, self.message = path, line, message
+        self.fatal = fatal  # nothing more of the file can be read or checked
 
     def render(self) -> str:
         return f"{self.path}:{self.line}: error: {self.message}" if self.line else f"{self.path}: error: {self.message}"
