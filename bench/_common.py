@@ -1,4 +1,5 @@
 """Helpers shared by the benchmarks: the repository on sys.path, percentiles, machine facts."""
+import math
 import os
 import platform
 import sys
@@ -11,19 +12,23 @@ LIB = os.path.join(ROOT, "docs", "examples", "actions.yaml")
 
 
 def percentile(values, q):
-    """The q-th percentile (0..100) by nearest rank."""
+    """The q-th percentile (0..100) by nearest rank: the ceil(q/100 * n)-th smallest value (1-based;
+    the smallest for q = 0); NaN for no values."""
     s = sorted(values)
     if not s:
         return float("nan")
-    k = max(0, min(len(s) - 1, int(round(q / 100.0 * len(s) + 0.5)) - 1))
-    return s[k]
+    rank = math.ceil(q * len(s) / 100.0 - 1e-9)  # q * n / 100 exactly an integer is that rank, not the next
+    return s[max(1, min(len(s), rank)) - 1]
 
 
 def machine():
+    """Facts about the machine, flat in every benchmark's JSON: Python, CPUs, the CPU model and the
+    1-minute load average when the figure was printed (the machine may be shared)."""
     model = ""
     try:
         with open("/proc/cpuinfo") as fh:
             model = next((line.split(":", 1)[1].strip() for line in fh if line.startswith("model name")), "")
     except OSError:
         pass
-    return {"python": platform.python_version(), "cpus": os.cpu_count(), "cpu": model}
+    return {"python": platform.python_version(), "cpus": os.cpu_count(), "cpu": model,
+            "loadavg_1min": round(os.getloadavg()[0], 2)}

@@ -7,21 +7,34 @@ timed T COUNT   one violation then silence, COUNT times, against a rule `for T s
 driver MODE HZ SECONDS   measure, printing one JSON line:
     raw:    publish a stamped Header on /bench/raw at HZ; round trip via echo -> one hop = rtt/2
     rubass: alternate /bench/cmd (geometry_msgs/PointStamped) between violating (x=2) and clear
-            (x=0) at HZ; each violation's time to the stop on /bench/stop (std_msgs/Header)
+            (x=0) at HZ; the k-th stop on /bench/stop (std_msgs/Header) answers the k-th violation
+
+Every publisher on a measured path (echo, driver, timed) publishes synchronously
+(`queue_size=None`), as the monitor's publish action does, so the raw hop and rubass's path pay
+the same publish; only the background load goes through rospy's queue thread.
 """
 import json
 import sys
 import threading
 import time
+import warnings
 
 import rospy
 from geometry_msgs.msg import PointStamped
 from std_msgs.msg import Float64, Header
 
 
+def _sync_publisher(topic, cls):
+    """A synchronous publisher (publish() writes on the caller's thread), rospy's warning about
+    queue_size=None silenced: it is on purpose."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        return rospy.Publisher(topic, cls, queue_size=None, tcp_nodelay=True)
+
+
 def echo():
     rospy.init_node("bench_echo")
-    pub = rospy.Publisher("/bench/raw_back", Header, queue_size=100, tcp_nodelay=True)
+    pub = _sync_publisher("/bench/raw_back", Header)
     rospy.Subscriber("/bench/raw", Header, pub.publish, tcp_nodelay=True)
     rospy.spin()
 
@@ -47,7 +60,7 @@ def driver(mode, hz, seconds):
     lock = threading.Lock()
     sent = {}
     if mode == "raw":
-        pub = rospy.Publisher("/bench/raw", Header, queue_size=100, tcp_nodelay=True)
+        pub = _sync_publisher("/bench/raw", Header)
 
         def back(msg):
             now = time.time()
@@ -59,7 +72,7 @@ def driver(mode, hz, seconds):
         rospy.Subscriber("/bench/raw_back", Header, back, tcp_nodelay=True)
         wait_for = "/bench/raw_back"
     else:
-        pub = rospy.Publisher("/bench/cmd", PointStamped, queue_size=100, tcp_nodelay=True)
+        pub = _sync_publisher("/bench/cmd", PointStamped)
         violations = []  # send times; the k-th stop answers the k-th violation (one stop per start)
         stops = []
 
@@ -114,7 +127,7 @@ def timed(duration, count):
     from std_msgs.msg import String
 
     rospy.init_node("bench_timed")
-    pub = rospy.Publisher("/bench/cmd", PointStamped, queue_size=10, tcp_nodelay=True)
+    pub = _sync_publisher("/bench/cmd", PointStamped)
     got = threading.Event()
     arrival = {}
     own = []

@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Engine cost of language version 2 (LANGUAGE.md §10–15); prints one JSON object per figure.
+"""Engine cost of language version 2 (docs/spec/LANGUAGE.md §10–15); prints one JSON object per figure.
 
 (a) engine CPU per message with v2 operators in the mix (within, latch, rate, stamp_age, a
     sector, a zone, active()) at 10, 100 and 1,000 rules: target <= 10 us and flat;
@@ -156,7 +156,7 @@ def _engine(spec):
 
 def _machine() -> dict:
     """Machine facts, with the load average: the machine may be shared while this runs."""
-    return {**_common.machine(), "loadavg_1min": round(os.getloadavg()[0], 2)}
+    return _common.machine()
 
 
 def _figures(costs):

@@ -166,7 +166,7 @@ def main() -> None:
                       "added_p50_ms": added, "limit_added_over_raw_hop_p50": ratio,
                       "target": "limit added <= 1.5 x raw hop at p50", "met": ratio is not None and ratio <= 1.5,
                       "clamped_wrong": out["wrong"], "lost": {n: args.samples - res[n]["n"] for n in res},
-                      "machine": _common.machine()}))
+                      **_common.machine()}))
 
 
 if __name__ == "__main__":

@@ -1,5 +1,7 @@
 #!/usr/bin/python3
-"""The blind window after a master restart: the master is SIGKILLed, down for --down seconds,
+"""The blind window after a master restart, and the monitor's reactions after it; prints JSON.
+
+The master is SIGKILLed, down for --down seconds,
 and started again on the same port, knowing nothing. Measured each time: how long after the
 new master answers it knows the monitor again (the window in which a node started after the
 restart cannot reach it), and the monitor's reactions to a driver started after the restart.
@@ -23,10 +25,10 @@ def known(master, topic, node="/rubass"):
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--restarts", type=int, default=10)
+    ap.add_argument("--restarts", type=int, default=10, help="master restarts (default 10)")
     ap.add_argument("--down", type=float, default=1.0, help="seconds without a master each time")
     ap.add_argument("--rate", type=float, default=4.0, help="the monitor's ~master_rate (Hz)")
-    ap.add_argument("--smoke", action="store_true")
+    ap.add_argument("--smoke", action="store_true", help="one restart, during the monitor's start-up")
     args = ap.parse_args()
     restarts = 1 if args.smoke else args.restarts
     import rosgraph
@@ -61,7 +63,7 @@ def main():
         "re_registration_ms_max": max(calls) if calls else None,
         "reaction_after_restart_ms_p50": ms(_common.percentile(lat, 50)),
         "reaction_after_restart_ms_p99": ms(_common.percentile(lat, 99)),
-        "violations": expected, "missed": unanswered, "machine": _common.machine()}))
+        "violations": expected, "missed": unanswered, **_common.machine()}))
 
 
 if __name__ == "__main__":

@@ -1,5 +1,7 @@
 #!/usr/bin/python3
-"""`for` fire instants through the live monitor: one violating message then silence, for T
+"""How late a `for` fires through the live monitor, after one violating message then silence.
+
+One violating message then silence, for T
 from 0 to 2 s. The monitor's own error (its ~events: the instant it dispatched the stop minus
 t0 + T, t0 being the violating message's arrival) is what the target is about; the stop's
 arrival at a subscriber minus (send time + T) adds the two ROS hops and is printed too.
@@ -18,7 +20,7 @@ from _rosbench import PrivateMaster, run_peer, spec_text, start_monitor, stop_pr
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--count", type=int, default=30, help="firings per T of 0.5 s or less (fewer for longer T)")
-    ap.add_argument("--smoke", action="store_true")
+    ap.add_argument("--smoke", action="store_true", help="2 firings of one T (0.1 s), to check it works")
     args = ap.parse_args()
     durations = [0.1] if args.smoke else [0.0, 0.05, 0.1, 0.5, 1.0, 2.0]
     all_errors, all_own = [], []

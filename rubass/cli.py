@@ -20,9 +20,16 @@ from .lang.source import SourceSet
 from .lang.sourcefile import read_source
 
 
-def _print_diags(diags: Sequence[Diagnostic], sources: Optional[SourceSet]) -> None:
+def _print_diags(diags: Sequence[Diagnostic], sources: Optional[SourceSet]) -> int:
+    """Print each diagnostic on stderr; the number of errors among them."""
     for d in diags:
         print(d.render(sources), file=sys.stderr)
+    return sum(d.severity == "error" for d in diags)
+
+
+def _count(n: int, noun: str) -> str:
+    """'1 node', '2 nodes'."""
+    return f"{n} {noun}{'' if n == 1 else 's'}"
 
 
 def cmd_check(args: argparse.Namespace) -> int:
@@ -36,21 +43,21 @@ def cmd_check(args: argparse.Namespace) -> int:
         except SpecError as exc:
             print(exc.render(), file=sys.stderr)
             lib_errors, warnings, lib_sources = after_failed_check(path, args.actions, model)
-            _print_diags(warnings + lib_errors, lib_sources)
-            n = sum(d.severity == "error" for d in exc.diagnostics) + len(lib_errors)
-            print(f"{path}: {n} error{'s' if n != 1 else ''}", file=sys.stderr)
+            # the summary counts every error printed above it: the spec's, and its libraries'
+            n = sum(d.severity == "error" for d in exc.diagnostics) + _print_diags(warnings + lib_errors, lib_sources)
+            print(f"{path}: {_count(n, 'error')}", file=sys.stderr)
             status = 1
             continue
         errors, warnings = after_check(checked, model)
-        _print_diags(checked.warnings + warnings, checked.sources)
-        if errors:
-            _print_diags(errors, checked.sources)
-            print(f"{path}: {len(errors)} error{'s' if len(errors) != 1 else ''}", file=sys.stderr)
+        n = _print_diags(checked.warnings + warnings, checked.sources) + _print_diags(errors, checked.sources)
+        if errors or n:
+            print(f"{path}: {_count(max(n, len(errors)), 'error')}", file=sys.stderr)
             status = 1
             continue
         if not args.quiet:
-            print(f"{path}: ok ({len(checked.rules)} rules, {len(checked.behaviours)} behaviours, "
-                  f"{len(spellings(checked.topics))} topics, {len(checked.nodes)} nodes, {len(checked.actions)} actions)")
+            print(f"{path}: ok ({_count(len(checked.rules), 'rule')}, {_count(len(checked.behaviours), 'behaviour')}, "
+                  f"{_count(len(spellings(checked.topics)), 'topic')}, {_count(len(checked.nodes), 'node')}, "
+                  f"{_count(len(checked.actions), 'action')})")
     return status
 
 
