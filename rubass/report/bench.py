@@ -1,4 +1,5 @@
-"""The monitor's measured reaction on this machine, from the benchmark (bench/reaction.py)."""
+"""The monitor's measured reaction: from bench/reaction.py's output given with --bench (measured where it was
+run), else the developers' figures in bench/README.md (their machine, their date: not this machine)."""
 from __future__ import annotations
 
 import json
@@ -22,6 +23,8 @@ class Reaction:
     p50_ms: float
     source: str
     cases: int
+    developers: bool = False  # the figures of bench/README.md: the developers' machine, not this one
+    date: str = ""  # the date of the developers' figures, when the README gives one
 
     def figures(self) -> str:
         """The figures as what they are: one case's, or the largest of each over several cases (the p50
@@ -99,19 +102,20 @@ def from_readme(path: str = README) -> Optional[Reaction]:
         first_row = m.start() if first_row < 0 else first_row
     if not rows:
         return None
-    when = _date_of(text, start + first_row)
+    date = _date_of(text, start + first_row)
+    when = f", figures of {date}" if date else ""
     return Reaction(max(r[2] for r in rows), max(r[1] for r in rows), max(r[0] for r in rows),
-                    f"bench/README.md (bench/reaction.py{when})", len(rows))
+                    f"bench/README.md (bench/reaction.py{when})", len(rows), developers=True, date=date)
 
 
 def _date_of(text: str, pos: int) -> str:
-    """", figures of DATE": the last "Figures of DATE" before `pos` in the part (top-level `#` section) of
-    the README that holds it; "" when that part dates nothing."""
+    """The last "Figures of DATE" before `pos` in the part (top-level `#` section) of the README that
+    holds it; "" when that part dates nothing."""
     part = 0
     for m in re.finditer(r"^# ", text[:pos], re.M):
         part = m.start()
     dates = re.findall(r"Figures of (\d{4}-\d\d-\d\d)", text[part:pos])
-    return f", figures of {dates[-1]}" if dates else ""
+    return dates[-1] if dates else ""
 
 
 def measured(path: Optional[str] = None) -> Optional[Reaction]:

@@ -43,13 +43,17 @@ def run(args: argparse.Namespace) -> int:
         print(f"rubass report: error: {exc}", file=sys.stderr)
         return 1
     results = [run_file(path, args.actions) for path in args.tests]
+    foreign = []  # test files of another spec: shown on the page, not counted, and the exit says so
     for r in results:
         for w in r.warnings:
             print(w, file=sys.stderr)
         if r.error:
             print(r.error, file=sys.stderr)
         elif r.spec is not None and os.path.realpath(r.spec.path) != os.path.realpath(spec.path):
-            print(f"rubass report: warning: {r.path} tests {r.spec.path}, not {args.spec}", file=sys.stderr)
+            foreign.append(r)
+            print(f"rubass report: error: {r.path} tests {r.spec.path}, not {args.spec}: its "
+                  f"{len(r.outcomes)} test{'s' if len(r.outcomes) != 1 else ''} are not evidence for this spec and are "
+                  f"not counted (give the test files of {args.spec}, whose 'spec:' names it)", file=sys.stderr)
     bags = [replay_bag(spec, path) for path in args.bag]
     for b in bags:
         if b.error:
@@ -57,6 +61,13 @@ def run(args: argparse.Namespace) -> int:
     ev = Evidence(spec, hazards, results, bags, reaction)
     build_matrix(ev)
     text = render(ev)
+    folder = os.path.dirname(os.path.abspath(args.output))
+    try:
+        os.makedirs(folder, exist_ok=True)
+    except OSError as exc:
+        print(f"rubass report: error: cannot write {args.output}: cannot create its folder {folder}: "
+              f"{exc.strerror or exc}", file=sys.stderr)
+        return 1
     tmp = args.output + ".tmp"
     try:
         with open(tmp, "w", encoding="utf-8") as fh:
@@ -69,6 +80,14 @@ def run(args: argparse.Namespace) -> int:
     failed = sum(not o.passed for o in outcomes)
     gaps = sum(1 for row in ev.matrix if row.gaps)
     ok = len(outcomes) - failed
+    untraced = len(ev.untraced)
     print(f"report written to {args.output}: {ok} test{'s' if ok != 1 else ''} passed, {failed} failed, "
-          f"{gaps} gap{'s' if gaps != 1 else ''} in the matrix")
-    return 1 if failed or any(r.error for r in results) or any(b.error for b in bags) else 0
+          f"{gaps} gap{'s' if gaps != 1 else ''} in the matrix"
+          + (f" ({untraced} rule{' traces' if untraced == 1 else 's trace'} to no hazard)" if untraced else "")
+          + (f"; {len(foreign)} test file{'s' if len(foreign) != 1 else ''} of another spec not counted" if foreign
+             else ""))
+    if reaction is not None and reaction.developers:
+        print(f"note: the monitor's reaction on the page is the developers' figures"
+              f"{f' of {reaction.date}' if reaction.date else ''} (bench/README.md), not this machine's: run "
+              f"bench/reaction.py on the robot's computer and pass its output with --bench", file=sys.stderr)
+    return 1 if failed or foreign or any(r.error for r in results) or any(b.error for b in bags) else 0

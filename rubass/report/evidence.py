@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import os
 from dataclasses import dataclass, field
-from typing import Any, Dict, FrozenSet, List, Optional, Sequence, Set, Tuple
+from typing import Any, Dict, List, Optional, Sequence, Set, Tuple
 
 import yaml
 
@@ -18,6 +18,7 @@ from ..testing.coverage import Coverage, coverage
 from ..testing.results import FileResult
 from ..testing.runner import Outcome
 from .bench import Reaction
+from .design import design_chain  # noqa: F401  (re-exported: the reaction by design lives in design.py)
 
 
 class ReportError(RubassError):
@@ -43,9 +44,10 @@ class BagRun:
 
 @dataclass
 class Row:
-    """One line of the traceability matrix: a hazard and one rule (or none) for it."""
+    """One line of the traceability matrix: a hazard and one rule (or none) for it; or a rule that traces
+    to no hazard (hazard None)."""
 
-    hazard: Hazard
+    hazard: Optional[Hazard]
     rule: Optional[str]  # rule key; None: the hazard has no rule
     behaviours: List[str]
     tests: List[Outcome]
@@ -66,6 +68,11 @@ class Evidence:
     def outcomes(self) -> List[Outcome]:
         """The outcomes of the tests of this spec (a file testing another spec is not evidence for it)."""
         return [o for r in self.results if self.same_spec(r) for o in r.outcomes]
+
+    @property
+    def untraced(self) -> List[str]:
+        """The rules that trace to no hazard (rows of the matrix with no hazard)."""
+        return [row.rule for row in self.matrix if row.hazard is None and row.rule is not None]
 
     def same_spec(self, r: FileResult) -> bool:
         return r.spec is not None and os.path.realpath(r.spec.path) == os.path.realpath(self.spec.path)
@@ -174,8 +181,38 @@ def build_matrix(ev: Evidence) -> None:
             if outcomes and not any(b.index in o.started for o in outcomes):
                 row.gaps.append("never started in any test")  # as the coverage's "behaviours never started"
             ev.matrix.append(row)
+    traced = _traced_rules(spec)
+    for r in spec.rules:
+        if r.key not in traced:
+            ev.matrix.append(_untraced_row(ev, r, [b for b in spec.behaviours if r.key in uses[b.index]]))
     if outcomes:
         ev.coverage = coverage(spec, outcomes)
+
+
+def _traced_rules(spec: CheckedSpec) -> Set[str]:
+    """The rules that trace to a hazard: those with @hazard (their own or their entity's), and the rules
+    they or a behaviour with @hazard use (a helper rule traces to the hazards of the rules built on it)."""
+    out: Set[str] = set()
+    for r in spec.rules:
+        if attrs(r).get("hazard"):
+            out |= _rules_used(spec, ast.RuleRef(r.key))
+    for b in spec.behaviours:
+        if attrs(b).get("hazard"):
+            out |= _rules_used(spec, b.cond)
+    return out
+
+
+def _untraced_row(ev: Evidence, r: Any, users: List[Any]) -> Row:
+    """A rule that traces to no hazard: a gap of its own, with the rule's other gaps beside it."""
+    ids = list(rule_ids_of(ev.spec, r))
+    outcomes = ev.outcomes
+    tests = covering(outcomes, ids) if ids else []
+    gaps = ["traces to no hazard"] + (["no behaviour acts on it"] if not users else [])
+    if not tests:
+        gaps.append(f"no test covers {' or '.join(ids)}" if ids else "no test covers it (it has no @id)")
+    if outcomes and not any(r.key in o.rules_true for o in outcomes):
+        gaps.append("never true in any test")
+    return Row(None, r.key, [behaviour_label(ev.spec, b.index) for b in users], tests, gaps + _failing(tests))
 
 
 def covering(outcomes: List[Outcome], names: Sequence[str]) -> List[Outcome]:
@@ -252,46 +289,6 @@ def spec_text(spec: CheckedSpec, span: Any) -> str:
             return fh.read().splitlines()[span.line - 1].strip()
     except (OSError, IndexError):
         return ""
-
-
-def design_chain(spec: CheckedSpec, expr: ast.Expr, _seen: FrozenSet[Any] = frozenset()) -> List[float]:
-    """The times on an expression's longest path from its inputs to its value (its reaction by
-    design): a `for` adds its time to its operand's; an `age(…) > T` adds T (from the last
-    message); `active(A)` takes the slowest behaviour that starts A; a rule reference the rule's
-    own; `within` and `latch` add nothing (true at once); of several operands, the slowest."""
-    if isinstance(expr, ast.For):
-        return design_chain(spec, expr.operand, _seen) + [_seconds_of(expr.duration)]
-    if isinstance(expr, ast.Within):
-        return design_chain(spec, expr.operand, _seen)
-    if isinstance(expr, ast.Latch):
-        return design_chain(spec, expr.set, _seen)
-    if isinstance(expr, ast.RuleRef):
-        if expr.key in _seen:
-            return []
-        return design_chain(spec, spec.rule(expr.key).expr, _seen | {expr.key})
-    if isinstance(expr, ast.Active):
-        paths = [design_chain(spec, b.cond, _seen | {b.index}) for b in spec.behaviours
-                 if b.index not in _seen and any(a.name == expr.action for a in b.actions)]
-        return max(paths, key=sum, default=[])
-    if isinstance(expr, ast.Binary):
-        age = _age_threshold(expr)
-        if age is not None:
-            return [age]
-    paths = [design_chain(spec, c, _seen) for c in ast.children(expr)]
-    return max(paths, key=sum, default=[])
-
-
-def _seconds_of(e: ast.Expr) -> float:
-    return float(e.value) if isinstance(e, ast.Lit) and isinstance(e.value, (int, float)) else 0.0
-
-
-def _age_threshold(e: ast.Binary) -> Optional[float]:
-    """T of `age(topic X) > T` (or `T < age(…)`): silence is seen T after the last message."""
-    if e.op in (">", ">=") and isinstance(e.left, ast.Age) and isinstance(e.right, ast.Lit):
-        return _seconds_of(e.right)
-    if e.op in ("<", "<=") and isinstance(e.right, ast.Age) and isinstance(e.left, ast.Lit):
-        return _seconds_of(e.left)
-    return None
 
 
 def hazards_via_rules(spec: CheckedSpec, b: Any) -> List[str]:

@@ -8,7 +8,8 @@ from html import escape
 from typing import Any, Iterable, List, Sequence
 
 from ..lang import ast
-from .evidence import (Evidence, attrs, behaviour_label, design_chain, hazards_via_rules, rule_ids_of, spec_text)
+from .design import design
+from .evidence import Evidence, attrs, behaviour_label, hazards_via_rules, rule_ids_of, spec_text
 from .timeline import svg
 
 CSS = """
@@ -58,10 +59,6 @@ def _table(head: Sequence[str], rows: List[str]) -> str:
             + "".join(rows) + "</tbody></table>")
 
 
-def _seconds(values: List[float]) -> str:
-    return " + ".join(f"{v:g} s" for v in values) if values else "immediate"
-
-
 def render(ev: Evidence) -> str:
     spec = ev.spec
     outcomes = ev.outcomes
@@ -69,33 +66,49 @@ def render(ev: Evidence) -> str:
     failed = len(outcomes) - passed
     gaps = sum(1 for row in ev.matrix if row.gaps)
     errors = [r for r in ev.results if r.error]
+    foreign = [r for r in ev.results if not r.error and not ev.same_spec(r)]
     now = datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%d %H:%M UTC")
     out = [f"<!DOCTYPE html><html lang='en'><head><meta charset='utf-8'><title>Safety evidence: "
            f"{_e(os.path.basename(spec.path))}</title><style>{CSS}</style></head><body>",
            f"<h1>Safety evidence for <code>{_e(os.path.basename(spec.path))}</code></h1>",
            f"<p class='muted'>{_e(spec.path)} · generated {now} by rubass report on {_e(platform.node())} "
            f"({_e(platform.machine())}, Python {_e(platform.python_version())})</p>"]
-    reaction = (f"<b>≤ {ev.reaction.worst_ms:g} ms</b>worst case measured ({_e(ev.reaction.p99_label())} "
-                f"{ev.reaction.p99_ms:g} ms)"
-                if ev.reaction else "<b>n/a</b>no benchmark figures")
+    untraced = len(ev.untraced)
+    untraced_note = (f"<br><span class='fail'>{untraced} rule{' traces' if untraced == 1 else 's trace'} to no "
+                     f"hazard</span>" if untraced else "")
     out.append("<div class='summary'>"
                f"<div class='card'><b>{len(ev.hazards)}</b>hazard{'s' if len(ev.hazards) != 1 else ''}</div>"
                f"<div class='card'><b>{len(spec.rules)} / {len(spec.behaviours)}</b>rules / behaviours</div>"
-               f"<div class='card'><b class='{'fail' if failed or errors else 'pass'}'>{passed} passed, {failed} failed"
-               f"</b>tests{f', {len(errors)} file(s) could not run' if errors else ''}</div>"
+               f"<div class='card'><b class='{'fail' if failed or errors or foreign else 'pass'}'>{passed} passed, "
+               f"{failed} failed</b>tests{f', {len(errors)} file(s) could not run' if errors else ''}"
+               f"{f', {len(foreign)} file(s) of another spec not counted' if foreign else ''}</div>"
                f"<div class='card'><b class='{'fail' if gaps else 'pass'}'>{gaps}</b>gap{'s' if gaps != 1 else ''} in the matrix"
-               "</div>"
-               f"<div class='card'>{reaction}</div></div>")
+               f"{untraced_note}</div>"
+               f"<div class='card'>{_reaction_card(ev)}</div></div>")
     out += _matrix(ev), _rules(ev), _behaviours(ev), _tests(ev), _bags(ev)
     out.append("</body></html>")
     return "\n".join(out)
+
+
+def _reaction_card(ev: Evidence) -> str:
+    r = ev.reaction
+    if r is None:
+        return "<b>n/a</b>no benchmark figures"
+    where = (f"the developers' figures{f' of {_e(r.date)}' if r.date else ''} (bench/README.md), "
+             f"<b class='fail'>not measured on this machine</b>" if r.developers else f"measured: {_e(r.source)}")
+    return f"<b>≤ {r.worst_ms:g} ms</b>monitor's worst case ({_e(r.p99_label())} {r.p99_ms:g} ms); {where}"
 
 
 def _matrix(ev: Evidence) -> str:
     rows = []
     for row in ev.matrix:
         h = row.hazard
-        details = "; ".join(f"{k}: {v}" for k, v in h.details.items())
+        if h is None:
+            hazard_cell = ("<b class='fail'>no hazard</b><br><span class='muted'>neither the rule nor any rule or "
+                           "behaviour using it names a <code>@hazard</code></span>")
+        else:
+            details = "; ".join(f"{k}: {v}" for k, v in h.details.items())
+            hazard_cell = f"<b>{_e(h.id)}</b> {_e(h.title)}<br><span class='muted'>{_e(details)}</span>"
         rule = ev.spec.rule(row.rule) if row.rule else None
         rule_cell = (f"<code>{_e(row.rule)}</code><br>{_rule_id(ev, rule)} {_e(' '.join(attrs(rule).get('title', ())))}"
                      if rule is not None else '<span class="muted">—</span>')
@@ -103,40 +116,61 @@ def _matrix(ev: Evidence) -> str:
                             f"{_e(o.name)}" for o in row.tests) or '<span class="muted">—</span>'
         status = ("<td class='gap'>" + "<br>".join(_e(g) for g in row.gaps) + "</td>") if row.gaps \
             else "<td class='ok'>covered</td>"
-        rows.append(f"<tr><td><b>{_e(h.id)}</b> {_e(h.title)}<br><span class='muted'>{_e(details)}</span></td>"
+        rows.append(f"<tr><td>{hazard_cell}</td>"
                     f"<td>{rule_cell}</td><td>{_list(row.behaviours)}</td><td>{tests}</td>{status}</tr>")
     note = ("<p>Each hazard of the risk assessment, the rules that detect it (<code>@hazard</code>), the behaviours "
             "that act on those rules, and the tests that cover them. <b>Covered</b> means named in a test's "
             "<code>covers</code>, as in the coverage below: a rule by its <code>@id</code> (its entity's when it has "
             "none; the hazard's when neither has one), and the hazard by its own id. A test that only makes a rule true "
             "covers nothing. Gaps are marked red: a hazard with no rule, a rule or hazard no test covers, a failing "
-            "test, a rule no behaviour acts on, a rule no test made true.</p>")
+            "test, a rule no behaviour acts on, a rule no test made true, and a rule that traces to no hazard (no "
+            "<code>@hazard</code> on it, its entity, or any rule or behaviour that uses it), listed after the "
+            "hazards.</p>")
     return "<h2 id='matrix'>Hazard → rule → behaviour → test</h2>" + note + \
         _table(["hazard", "rule", "behaviours", "tests", "status"], rows)
 
 
+DESIGN_NOTE = ("A reaction by design is the time on the slowest path from the inputs to the value (an upper "
+               "bound): each <code>for</code> adds its time; a comparison of ages adds the time after the last "
+               "message that makes it true (<code>age(…) &gt; T</code>: T; <code>2 * age(…) &gt; 3 s</code>: "
+               "1.5 s; sums, differences, constant multiples, <code>min</code> and <code>max</code> of "
+               "<code>age</code> and <code>stamp_age</code> are solved, in either orientation and under "
+               "<code>not</code>); <code>frequency(…, W)</code> adds its window W (1 s by default); "
+               "<code>alive()</code>, <code>cpu()</code> and <code>memory()</code> two node samples at the monitor's "
+               "default <code>~node_rate</code> of 10 Hz (0.2 s; a slower rate lengthens it); "
+               "<code>active(A)</code> the slowest behaviour that starts A; <code>within</code> and "
+               "<code>latch</code> add nothing to turning true; of several operands the slowest counts. Where no "
+               "bound can be given, the page says <i>not computed</i> and why.")
+
+
 def _reaction_note(ev: Evidence) -> str:
-    if ev.reaction is None:
-        return "<p>No benchmark figures were found, so the monitor's own reaction is not stated.</p>"
+    note = f"<p>{DESIGN_NOTE}</p>"
     r = ev.reaction
-    return (f"<p>Every rule's reaction by design is the time on its slowest path (<code>for</code>, <code>age(…) &gt; T</code>, "
-            f"through the rules it uses; see Behaviours). The monitor "
-            f"adds its own reaction, measured on this machine from the violating message to the stop received by "
-            f"the base: <b>{_e(r.figures())}</b> (source: {_e(r.source)}).</p>")
+    if r is None:
+        return note + "<p>No benchmark figures were found, so the monitor's own reaction is not stated.</p>"
+    if r.developers:
+        return note + (f"<p>The monitor adds its own reaction, from the violating message to the stop received by "
+                       f"the base: <b>{_e(r.figures())}</b>. <b>These are the developers' figures"
+                       f"{f' of {_e(r.date)}' if r.date else ''} (bench/README.md), not measured on this machine.</b> "
+                       f"Run <code>/usr/bin/python3 bench/reaction.py &gt; reaction.jsonl</code> on the robot's "
+                       f"computer and pass <code>--bench reaction.jsonl</code> to state its own.</p>")
+    return note + (f"<p>The monitor adds its own reaction, from the violating message to the stop received by the "
+                   f"base, measured by bench/reaction.py where it was run: <b>{_e(r.figures())}</b> "
+                   f"(source: {_e(r.source)}).</p>")
 
 
 def _rules(ev: Evidence) -> str:
     rows = []
     worst = ev.reaction.worst_ms if ev.reaction else None
     for r in ev.spec.rules:
-        times = design_chain(ev.spec, ast.RuleRef(r.key))  # through the rules it uses
-        total = sum(times)
-        bound = f"{_seconds(times)}" + (f" + ≤ {worst:g} ms = ≤ {total + worst / 1000:.4g} s" if worst is not None else "")
+        d = design(ev.spec, ast.RuleRef(r.key))  # through the rules it uses
+        bound = _e(d.text()) + (f" + ≤ {worst:g} ms = ≤ {d.total + worst / 1000:.4g} s"
+                                if worst is not None and not d.unknown else "")
         rows.append(f"<tr><td><code>{_e(r.key)}</code></td><td>{_rule_id(ev, r)}</td><td>{_attr(r, 'hazard')}</td>"
                     f"<td>{_attr(r, 'title')}</td><td>{_attr(r, 'ref')}</td><td>{bound}</td>"
                     f"<td><pre>{_e(spec_text(ev.spec, r.span))}</pre></td></tr>")
     return ("<h2 id='rules'>Rules</h2>" + _reaction_note(ev)
-            + _table(["rule", "id", "hazard", "title", "ref", "reaction (design + measured)", "text"], rows))
+            + _table(["rule", "id", "hazard", "title", "ref", "reaction (design + monitor)", "text"], rows))
 
 
 def _behaviours(ev: Evidence) -> str:
@@ -147,17 +181,15 @@ def _behaviours(ev: Evidence) -> str:
         via = [h for h in hazards_via_rules(ev.spec, b) if h not in hazards]
         hz = _list(hazards) if hazards else ""
         hz += (" " if hz else "") + (f"<span class='muted'>via rules: {_list(via)}</span>" if via else "")
-        times = design_chain(ev.spec, b.cond, frozenset({b.index}))
-        bound = _seconds(times) + (f" + ≤ {worst:g} ms" if worst is not None else "")
+        d = design(ev.spec, b.cond, frozenset({b.index}))
+        bound = _e(d.text()) + (f" + ≤ {worst:g} ms" if worst is not None and not d.unknown else "")
         rows.append(f"<tr><td>{b.index}</td><td><b>{_e(behaviour_label(ev.spec, b.index))}</b></td>"
                     f"<td>{_attr(b, 'id')}</td><td>{hz or _list([])}</td><td>{_attr(b, 'title')}</td>"
                     f"<td>{_list(a.name for a in b.actions)}</td><td>{bound}</td>"
                     f"<td><pre>{_e(spec_text(ev.spec, b.span))}</pre></td></tr>")
-    return ("<h2 id='behaviours'>Behaviours</h2><p>A behaviour's time is its slowest path from its inputs through its "
-            "rules to its condition: each <code>for</code> on it adds its time, an <code>age(…) &gt; T</code> adds T, "
-            "<code>active(A)</code> the time of the slowest behaviour that starts A; <code>within</code> and "
-            "<code>latch</code> add nothing (true at once); then the monitor's measured worst case.</p>" + _table(["#", "name", "id", "hazard", "title", "actions", "reaction (design + measured)",
-                                        "text"], rows))
+    return ("<h2 id='behaviours'>Behaviours</h2><p>A behaviour's time is its slowest path from its inputs through "
+            "its rules to its condition, reckoned as the rules' (see Rules), then the monitor's worst case.</p>"
+            + _table(["#", "name", "id", "hazard", "title", "actions", "reaction (design + monitor)", "text"], rows))
 
 
 def _tests(ev: Evidence) -> str:

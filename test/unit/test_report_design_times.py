@@ -6,7 +6,7 @@ as their sum, a `within` as a delay, and `active()` (an escalation ladder) and `
 import pytest
 
 from rubass.lang import ast, check_text
-from rubass.report.evidence import design_chain
+from rubass.report.design import design_chain
 
 from conftest import ROOT
 

@@ -107,7 +107,7 @@ def test_report_bad_inputs_are_one_line_errors(inputs, tmp_path, capsys, write):
     assert "expected 'hazards:'" in capsys.readouterr().err
     assert main(["report", spec, "--bag", str(tmp_path / "none.bag"), "-o", str(tmp_path / "y.html")]) == 1
     assert "no such file" in capsys.readouterr().err
-    assert main(["report", spec, "-o", str(tmp_path / "no" / "dir" / "z.html")]) == 1
+    assert main(["report", spec, "-o", str(tmp_path / "bad.yaml" / "dir" / "z.html")]) == 1  # under a file
     assert "cannot write" in capsys.readouterr().err
 
 
