@@ -52,8 +52,8 @@ def run(args: argparse.Namespace) -> int:
         elif r.spec is not None and os.path.realpath(r.spec.path) != os.path.realpath(spec.path):
             foreign.append(r)
             print(f"rubass report: error: {r.path} tests {r.spec.path}, not {args.spec}: its "
-                  f"{len(r.outcomes)} test{'s' if len(r.outcomes) != 1 else ''} are not evidence for this spec and are "
-                  f"not counted (give the test files of {args.spec}, whose 'spec:' names it)", file=sys.stderr)
+                  f"{len(r.outcomes)} test{'s are' if len(r.outcomes) != 1 else ' is'} not evidence for this spec and "
+                  f"{'are' if len(r.outcomes) != 1 else 'is'} not counted (give the test files of {args.spec}, whose 'spec:' names it)", file=sys.stderr)
     bags = [replay_bag(spec, path) for path in args.bag]
     for b in bags:
         if b.error:

@@ -95,7 +95,7 @@ def _reaction_card(ev: Evidence) -> str:
     if r is None:
         return "<b>n/a</b>no benchmark figures"
     where = (f"the developers' figures{f' of {_e(r.date)}' if r.date else ''} (bench/README.md), "
-             f"<b class='fail'>not measured on this machine</b>" if r.developers else f"measured: {_e(r.source)}")
+             f"<span class='fail'>not measured on this machine</span>" if r.developers else f"measured: {_e(r.source)}")
     return f"<b>≤ {r.worst_ms:g} ms</b>monitor's worst case ({_e(r.p99_label())} {r.p99_ms:g} ms); {where}"
 
 
@@ -133,8 +133,8 @@ def _matrix(ev: Evidence) -> str:
 DESIGN_NOTE = ("A reaction by design is the time on the slowest path from the inputs to the value (an upper "
                "bound): each <code>for</code> adds its time; a comparison of ages adds the time after the last "
                "message that makes it true (<code>age(…) &gt; T</code>: T; <code>2 * age(…) &gt; 3 s</code>: "
-               "1.5 s; sums, differences, constant multiples, <code>min</code> and <code>max</code> of "
-               "<code>age</code> and <code>stamp_age</code> are solved, in either orientation and under "
+               "1.5 s; sums, constant multiples, <code>min</code> and <code>max</code> of <code>age</code> and "
+               "<code>stamp_age</code> and constants added to them are solved, in either orientation and under "
                "<code>not</code>); <code>frequency(…, W)</code> adds its window W (1 s by default); "
                "<code>alive()</code>, <code>cpu()</code> and <code>memory()</code> two node samples at the monitor's "
                "default <code>~node_rate</code> of 10 Hz (0.2 s; a slower rate lengthens it); "
