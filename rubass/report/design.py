@@ -87,7 +87,8 @@ def design(spec: CheckedSpec, expr: ast.Expr, seen: FrozenSet[Any] = frozenset()
 
 
 def design_chain(spec: CheckedSpec, expr: ast.Expr, seen: FrozenSet[Any] = frozenset()) -> List[float]:
-    """The times on an expression's slowest path to turning true (see `design`); [] when not computed."""
+    """The times on an expression's slowest path to turning true (see `design`), of its computed parts
+    only: `design(…).unknown` says what is not computed (then the sum is no bound)."""
     return design(spec, expr, seen).chain
 
 
