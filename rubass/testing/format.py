@@ -119,8 +119,8 @@ class _Reader:
             raise self.fail(line, f"{what} must be a mapping")
         for k in value:
             if k not in keys:  # left out, and reading goes on
-                self.errors.append(self.fail(value.key_at(k), f"unknown key '{k}' in {what}"
-                                                              f"{did_you_mean(str(k), keys)} (keys: {', '.join(keys)})"))
+                hint = f"{did_you_mean(str(k), keys)} (keys: {', '.join(keys)})"
+                self.errors.append(self.fail(value.key_at(k), f"unknown key '{k}' in {what}{hint}"))
         for k in required:
             if k not in value:
                 raise self.fail(value.line, f"{what} needs '{k}'")

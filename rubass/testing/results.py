@@ -87,12 +87,20 @@ def _load_spec(tf: TestFile, actions: List[str], errors: List[TestFileError]) ->
             except SpecError as exc:
                 why = "does not fit the types of the topics this file declares (as `rubass check --bag` says of a " \
                       "recording of them)"
-                errors.append(TestFileError(tf.path, tf.spec_line, f"spec {tf.spec} {why}:\n{exc.render()}"))
+                errors.append(TestFileError(tf.path, tf.spec_line, _spec_error(tf.spec, why, exc)))
                 return None
         return spec
     except SpecError as exc:
-        errors.append(TestFileError(tf.path, tf.spec_line, f"spec {tf.spec} cannot be used:\n{exc.render()}"))
+        errors.append(TestFileError(tf.path, tf.spec_line, _spec_error(tf.spec, "cannot be used", exc)))
         return None
+
+
+def _spec_error(path: str, why: str, exc: SpecError) -> str:
+    """`spec robot.rbs WHY:` and the spec's errors, its path as the user sees it (relative below here)."""
+    shown = shown_path(path)
+    text = "\n".join(shown + line[len(path):] if line.startswith(path + ":") else line
+                     for line in exc.render().splitlines())
+    return f"spec {shown} {why}:\n{text}"
 
 
 def _unknown_covers(spec: CheckedSpec, tf: TestFile, path: str) -> List[str]:

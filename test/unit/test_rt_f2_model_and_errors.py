@@ -91,8 +91,8 @@ tests:
       /odom: {type: geometry_msgs/Twist, rate: 10 Hz, field: linear.x, values: "0x10"}
 """)
     code, _, err = run(capsys, path)
-    assert code == 2 and f"{path}:5: error: rule 'base.fast' reads /odom.twist.twist.linear.x, but in geometry_msgs/Twist" \
-        in err, err
+    assert code == 2 and f"{path}:5: error: rule 'base.fast' reads /odom.twist.twist.linear.x, but in " \
+                         f"geometry_msgs/Twist" in err, err
     assert "does not fit" not in err
 
 
