@@ -413,5 +413,11 @@ def _path_text(path: Path) -> str:
 
 def read_test_file(path: str) -> TestFile:
     """The test file at `path` with every error found in it (`errors`), or TestFileError when it
-    cannot be read at all (not YAML, not a mapping, no spec or tests, no ROS Python here)."""
-    return _Reader(path).read()
+    cannot be read at all (not YAML, not a mapping, no spec or tests, no ROS Python here): then its
+    `before` holds the errors found until then (an unknown key `spce` beside the missing `spec`)."""
+    reader = _Reader(path)
+    try:
+        return reader.read()
+    except TestFileError as exc:
+        exc.before = list(reader.errors)
+        raise

@@ -47,7 +47,7 @@ def run_file(path: str, extra_actions: Sequence[str] = ()) -> FileResult:
             result.error = "\n".join(_rendered(errors))
             return result
     except TestFileError as exc:  # the file cannot be read at all
-        result.error = exc.render()
+        result.error = "\n".join(_rendered(exc.before + [exc]))
         return result
     except Exception as exc:  # a bug must not hide the other files' results behind a traceback
         result.error = f"{path}: error: internal error while reading the tests: {type(exc).__name__}: {exc}"

@@ -15,6 +15,7 @@ class TestFileError(RubassError):
         super().__init__(message)
         self.path, self.line, self.message = path, line, message
         self.fatal = fatal  # nothing more of the file can be read or checked
+        self.before: List["TestFileError"] = []  # errors found before this one stopped the reading
 
     def render(self) -> str:
         return f"{self.path}:{self.line}: error: {self.message}" if self.line else f"{self.path}: error: {self.message}"

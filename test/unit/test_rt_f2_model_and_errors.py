@@ -168,3 +168,12 @@ def test_the_file_error_order_is_kept_for_one_error(write, capsys):
     code, _, err = run(capsys, path)
     assert code == 2 and err.strip() == f"{path}:2: error: tests is empty: a file needs at least one test"
     assert os.path.exists(path)
+
+
+def test_a_misspelt_required_key_is_said_with_its_suggestion(write, capsys):
+    """`spce:` for `spec:`: the unknown key with its did-you-mean, not only the missing spec."""
+    path = write("w.test.yaml", "spce: w.rbs\ntests:\n  - name: t\n")
+    code, _, err = run(capsys, path)
+    assert code == 2
+    assert err.strip() == f"{path}:1: error: unknown key 'spce' in a test file; did you mean 'spec'? (keys: spec, " \
+                          f"actions, model, tests)", err
