@@ -9,7 +9,7 @@ from ..lang.ast import PathElem
 from ..lang.fieldmodel import FieldInfo
 from ..lang.msgdef import DefinitionError, Registry
 from ..lang.sysmodel import SystemModel, norm_topic
-from .format import TestFile
+from .cases import TestFile
 
 
 class DeclaredModel:

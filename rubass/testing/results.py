@@ -11,7 +11,8 @@ from ..lang.errors import did_you_mean
 from ..lang.model import CheckedSpec
 from .coverage import traced, unknown_covers
 from .declared import declared_model
-from .format import TestFile, read_test_file
+from .cases import TestFile
+from .format import read_test_file
 from .runner import Outcome, execute, prepare_all
 from .yamlpos import TestFileError
 

@@ -16,7 +16,7 @@ from ..lang.errors import did_you_mean
 from ..lang.model import CheckedSpec
 from ..lang.topicnames import resolve, spellings
 from ..replay.run import replay
-from .format import UNSET, Case, Expect, MessageInput
+from .cases import UNSET, Case, Expect, MessageInput
 from .messages import MessageError, assign, has_header
 from .yamlpos import TestFileError
 
