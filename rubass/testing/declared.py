@@ -13,17 +13,26 @@ from .cases import TestFile
 
 
 class DeclaredModel:
-    """A SystemModel whose declared topics say nothing of fields their type lacks: the runner says
-    that at the test's topic line (the spec or the declared type is wrong, and the test shows which
-    type it means); kinds and units are the model's."""
+    """A SystemModel whose declared topics leave a field their type lacks to the runner, which says it
+    at the test's topic line (the spec or the declared type is wrong, and the test shows which type it
+    means); kinds, units and what only the model sees (an index past a fixed-size array) are the model's."""
 
-    def __init__(self, model: SystemModel, declared: Set[str]) -> None:
-        self.model, self.declared = model, declared
+    def __init__(self, model: SystemModel, declared: Dict[str, Any]) -> None:
+        self.model, self.declared = model, declared  # declared: topic -> the message class the test gives
 
     def field(self, topic: str, path: Tuple[PathElem, ...]) -> Optional[FieldInfo]:
+        from ..ros.msgtypes import check_path
+
         info = self.model.field(topic, path)
-        if info is not None and info.kind == "missing" and norm_topic(topic) in self.declared:
-            return None
+        cls = self.declared.get(norm_topic(topic))
+        if info is not None and info.kind == "missing" and cls is not None:
+            plain = []
+            for p in path:  # as the runner checks it: up to a slice or [*]
+                if not isinstance(p, (str, int)):
+                    break
+                plain.append(p)
+            if check_path(cls, tuple(plain)):
+                return None
         return info
 
     def has_stamp(self, topic: str) -> Optional[bool]:
@@ -64,11 +73,11 @@ def declared_model(tf: TestFile) -> Optional[DeclaredModel]:
         undefined = model.undefined_types()
         if undefined:
             try_installed(model.registry, undefined, ())
-    declared = set()
+    declared = {}
     for name, cls in types.items():
         if name in twice or model.type_of(name) is not None:
             continue
         model.topics[name] = cls._type
         _add_class(model.registry, cls)
-        declared.add(name)
+        declared[name] = cls
     return DeclaredModel(model, declared)

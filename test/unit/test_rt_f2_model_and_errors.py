@@ -177,3 +177,14 @@ def test_a_misspelt_required_key_is_said_with_its_suggestion(write, capsys):
     assert code == 2
     assert err.strip() == f"{path}:1: error: unknown key 'spce' in a test file; did you mean 'spec'? (keys: spec, " \
                           f"actions, model, tests)", err
+
+
+def test_an_index_past_a_fixed_size_array_is_the_models_error(write, capsys):
+    """What only the model sees (float64[9] has no [9]) stays an error, as `check --bag` says it."""
+    write("lib.yaml", LIB)
+    rbs = write("w.rbs", SPEC.replace("/odom.twist.twist.linear.x > LIMIT", "/fix.position_covariance[9] > 1"))
+    path = write("w.test.yaml", "spec: w.rbs\ntests:\n  - name: t\n    topics:\n      /fix:\n"
+                                "        type: sensor_msgs/NavSatFix\n        messages: [{at: 1 s, altitude: 3}]\n")
+    code, _, err = run(capsys, path)
+    assert code == 2 and f"{path}:1: error: spec {rbs} does not fit" in err, err
+    assert "beyond the end of 'position_covariance'" in err
