@@ -44,7 +44,8 @@ def test_replay_throughput(tmp_path):
 
 
 @pytest.mark.ros
-@pytest.mark.parametrize("script", ["reaction.py", "timed.py", "scale.py", "reload.py", "master_restart.py"])
+@pytest.mark.parametrize("script", ["reaction.py", "timed.py", "scale.py", "reload.py", "master_restart.py",
+                                    "reload_storm.py", "soak.py"])
 def test_ros_benchmarks(script):
     if not os.path.exists("/usr/bin/rosmaster"):
         pytest.skip("ROS 1 is not installed")
@@ -52,6 +53,9 @@ def test_ros_benchmarks(script):
     assert rows and all(r["benchmark"] == script[:-3] for r in rows)
     if script == "reaction.py":
         assert rows[0]["raw_hop"]["n"] > 0 and rows[0]["rubass"]["n"] > 0
+        assert rows[0]["rubass_unanswered"] == 0 and rows[0]["rubass_extra_stops"] == 0
+    if script in ("reload_storm.py", "soak.py"):  # their --smoke: a short run of the same measurement
+        assert rows[0]["missed"] == 0 and rows[0]["monitor_alive"] and rows[0]["violations"] > 0
     if script == "reload.py":
         assert rows[0]["reloads"] == 2 and rows[0]["missed"] == 0
     if script == "master_restart.py":
