@@ -23,6 +23,7 @@ import concurrent.futures
 import os
 import re
 import socket
+import sys
 import threading
 import time
 import xmlrpc.client
@@ -36,6 +37,7 @@ from . import rpc
 from .agentbook import AGENT_TOPIC, encode, is_loopback, node_entry
 from .nodes import NodeSampler, NodeStatus
 from .params import ParamError, read_rate, unknown_params
+from .startup import init_node, wants_help
 
 Log = Callable[[str, str], None]
 
@@ -134,6 +136,10 @@ class Agent:
 
 
 AGENT_PARAMS = ("node_rate", "discover_rate")  # what main() reads
+USAGE = ("usage: rosrun rubass agent [_node_rate:=HZ] [_discover_rate:=HZ]\n"
+         "Samples alive, CPU and memory of the nodes on this host at node_rate (default 10 Hz) and publishes\n"
+         f"them on {AGENT_TOPIC} for a rubass monitor on another host; asks the master for the node list at\n"
+         "discover_rate (default 1 Hz). See docs/multihost.md.\n")
 
 
 def main(argv: Optional[List[str]] = None) -> int:
@@ -144,7 +150,12 @@ def main(argv: Optional[List[str]] = None) -> int:
     from .master_watch import MasterWatch
     from .rosout_param import keep_rosout_flag
 
-    rospy.init_node(default_name(), argv=argv)
+    if wants_help(argv):
+        sys.stdout.write(USAGE)
+        return 0
+    code = init_node(default_name(), argv, True, lambda text: sys.stderr.write(f"rubass agent: {text}\n"))
+    if code is not None:
+        return code
     keep_rosout_flag()  # no log call asks the master anything (one would block while its host is cut off)
     log: Log = lambda level, text: {"debug": rospy.logdebug, "info": rospy.loginfo,  # noqa: E731
                                     "warn": rospy.logwarn, "error": rospy.logerr}[level](text)

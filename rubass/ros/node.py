@@ -10,12 +10,23 @@ import rospy
 
 from ..actions.latches import adopt_old_default, default_path
 from .monitor import ConfigError, Monitor
-from .params import ParamError, read_config, unknown_params
+from .params import KNOWN, ParamError, read_config, unknown_params
 from .rosout_param import keep_rosout_flag
+from .startup import init_node, wants_help
+
+USAGE = ("usage: rosrun rubass monitor _spec:=SPEC.rbs [_actions:=LIBRARY.yaml] [_NAME:=VALUE ...]\n"
+         "The rubass monitor node: enforces the rules of SPEC on the live system until stopped (SIGINT/SIGTERM);\n"
+         "SIGHUP or the ~reload service reloads them. Private parameters: " + ", ".join(KNOWN) + "\n"
+         "(see docs/monitor.md). Check a spec first with: rubass check SPEC.rbs --actions LIBRARY.yaml\n")
 
 
 def main(argv: Optional[List[str]] = None) -> int:
-    rospy.init_node("rubass", argv=argv, disable_signals=True)  # Monitor handles SIGINT/SIGTERM
+    if wants_help(argv):
+        sys.stdout.write(USAGE)
+        return 0
+    code = init_node("rubass", argv, False, lambda text: sys.stderr.write(f"rubass: {text}\n"))
+    if code is not None:
+        return code  # Monitor handles SIGINT/SIGTERM once it runs; before, a signal ends the wait for the master
     keep_rosout_flag()  # no log call asks the master anything (one would block while its host is cut off)
     sys.setswitchinterval(0.0005)  # a busy thread must not delay a deadline by the default 5 ms
     try:

@@ -1,0 +1,79 @@
+"""A node's start, before it protects anything: `--help`, and rospy.init_node's wait for a master
+that is not up yet, which SIGINT or SIGTERM must end with one line, not a traceback."""
+from __future__ import annotations
+
+import signal
+import sys
+import time
+from typing import Callable, List, Optional
+
+from .exiting import exit_within
+
+
+class _Stopped(BaseException):
+    """A signal ended the wait for the master: a BaseException, so that rospy's `except Exception`
+    around its retries lets it through."""
+
+
+STOP_GRACE = 1.0  # s: nothing was started, so rospy gets this long to shut down before the process exits
+
+
+def wants_help(argv: Optional[List[str]]) -> bool:
+    """Whether the command line asks for help (ROS remappings `name:=value` aside)."""
+    args = sys.argv[1:] if argv is None else argv[1:]
+    return any(a in ("-h", "--help", "help") for a in args if ":=" not in a)
+
+
+def init_node(name: str, argv: Optional[List[str]], rospy_signals: bool, say: Callable[[str], None]) -> Optional[int]:
+    """rospy.init_node, after waiting for the master as long as it does not answer. None once the node
+    is up (with rospy's own SIGINT/SIGTERM handlers if `rospy_signals`, else none: the node installs
+    its own); else the exit code, after `say` has told why: 0 when SIGINT or SIGTERM ended the wait,
+    1 when the master went away during the start. rospy is then shut down, and the process exits within
+    STOP_GRACE seconds even if rospy's shutdown waits for the master."""
+    import rosgraph
+    import rospy
+
+    uri = rosgraph.get_master_uri()
+    stopped: List[int] = []
+
+    def stop(signum: int, _frame: object) -> None:
+        # Not rospy's handler: it shuts rospy down on this (the main) thread, which holds the topic
+        # manager's lock while it retries the master, and the shutdown waits for that lock: for good.
+        stopped.append(signum)
+        raise _Stopped(signum)
+
+    previous = {s: signal.signal(s, stop) for s in (signal.SIGINT, signal.SIGTERM)}
+    failed = ""
+    try:
+        _wait_for_master(uri, say)  # rospy waits only if no _param:= is given; with one it raises at once
+        rospy.init_node(name, argv=argv, disable_signals=True)
+    except _Stopped:
+        pass
+    except OSError as exc:  # the master went away between our wait and rospy's calls
+        failed = f"the ROS master at {uri} stopped answering during the start ({exc.strerror or exc})"
+    except rospy.exceptions.ROSInitException as exc:
+        if not (stopped or rospy.is_shutdown()):
+            failed = f"cannot start: {exc}"
+    finally:
+        for s, handler in previous.items():
+            signal.signal(s, handler)
+    if not (stopped or failed or rospy.is_shutdown()):
+        if rospy_signals:
+            rospy.core.register_signals()
+        return None
+    say(failed or f"stopped before the ROS master at {uri} answered; nothing was started")
+    exit_within(STOP_GRACE)
+    rospy.signal_shutdown("stopped before start")
+    return 1 if failed else 0
+
+
+def _wait_for_master(uri: str, say: Callable[[str], None]) -> None:
+    """Until the master at `uri` answers (a signal ends the wait: the handler raises)."""
+    import rosgraph
+
+    said = False
+    while not rosgraph.is_master_online(uri):
+        if not said:
+            say(f"waiting for the ROS master at {uri} (is roscore running? is ROS_MASTER_URI right?)")
+            said = True
+        time.sleep(0.5)

@@ -1,0 +1,81 @@
+"""The monitor and the agent before their master answers: `--help` prints the usage and starts no
+node; started before the master (with a `_param:=`, rospy.init_node raised ConnectionRefusedError at
+once), they wait for it and say so; SIGINT or SIGTERM during that wait ends the process at once with
+one line, no traceback (rospy's own wait held its topic lock, so its shutdown hung for 5 s, or for good)."""
+import os
+import signal
+import socket
+import subprocess
+import sys
+import time
+
+import pytest
+
+from conftest import ROOT
+
+pytestmark = pytest.mark.ros
+
+SCRIPTS = ("monitor", "agent")
+
+
+def _nobody_listening() -> str:
+    with socket.socket() as s:  # a port free now: no master answers there
+        s.bind(("127.0.0.1", 0))
+        return f"http://127.0.0.1:{s.getsockname()[1]}"
+
+
+def _env(tmp_path):
+    return dict(os.environ, ROS_MASTER_URI=_nobody_listening(), ROS_IP="127.0.0.1", ROS_HOME=str(tmp_path),
+                PYTHONDONTWRITEBYTECODE="1")
+
+
+@pytest.mark.parametrize("script", SCRIPTS)
+def test_help_prints_the_usage_and_starts_no_node(tmp_path, script):
+    out = subprocess.run([sys.executable, os.path.join(ROOT, "scripts", script), "--help"], env=_env(tmp_path),
+                         capture_output=True, text=True, timeout=20)
+    assert out.returncode == 0, out.stderr
+    assert out.stdout.startswith(f"usage: rosrun rubass {script}"), out.stdout
+    assert "Unable to register" not in out.stdout + out.stderr  # it never tried to reach a master
+
+
+@pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM], ids=["SIGINT", "SIGTERM"])
+@pytest.mark.parametrize("script", SCRIPTS)
+def test_a_signal_while_waiting_for_the_master_exits_at_once_without_a_traceback(tmp_path, script, sig):
+    env = _env(tmp_path)
+    param = "_spec:=/nonexistent.rbs" if script == "monitor" else "_node_rate:=5"
+    proc = subprocess.Popen([sys.executable, os.path.join(ROOT, "scripts", script), param],
+                            env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                            start_new_session=True,  # SIGINT not ignored as in a background job
+                            preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
+    try:
+        first = proc.stderr.readline()
+        assert f"waiting for the ROS master at {env['ROS_MASTER_URI']}" in first, first
+        time.sleep(1.0)
+        assert proc.poll() is None  # still waiting
+        sent = time.monotonic()
+        proc.send_signal(sig)
+        out, err = proc.communicate(timeout=15)
+        took = time.monotonic() - sent
+    finally:
+        if proc.poll() is None:
+            os.killpg(proc.pid, signal.SIGKILL)
+            proc.wait()
+    assert proc.returncode == 0, (out, err)
+    assert took < 3.0, took  # rospy's own shutdown on the waiting thread took 5 s for the agent, for good for the monitor
+    assert "Traceback" not in err, err
+    assert f"stopped before the ROS master at {env['ROS_MASTER_URI']} answered" in err, err
+
+
+def test_a_monitor_started_before_its_master_waits_for_it_then_enforces(ros, tmp_path):
+    import rosharness
+
+    ros.master.stop()  # the robot's master is not up yet (rosrun before roscore, or another host booting)
+    mon = ros.monitor(rosharness.spec(tmp_path, "entity base { rules: fast: topic /cmd_vel.linear.x > 1 m/s; }\n"
+                                                "if (base.fast) then { brake; }\n"), wait=False)
+    rosharness.wait_log(mon, ros, f"waiting for the ROS master at {ros.master.uri}")
+    time.sleep(1.0)
+    assert mon.poll() is None, ros.log(mon)
+    ros.master.restart()
+    ros.wait_service("/rubass/reset", mon)
+    assert rosharness.brake_after(ros, 2.0), ros.log(mon)
+    assert "Traceback" not in ros.log(mon)
