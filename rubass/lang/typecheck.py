@@ -13,7 +13,7 @@ from .fieldmodel import FieldModel
 from .grammar import FUNCTIONS
 from .ops import BINARY, SCALAR_FUNCTIONS, UNARY, scalar_fn
 from .source import Span
-from .units import DIMENSIONLESS, ODD, TIME, UNITS, Dimension, dim_mul, dim_sqrt, dimension_name
+from .units import DIMENSIONLESS, ODD, TIME, UNITS, Dimension, dim_mul, dim_sqrt, dimension_name, unit_suggestion
 from .values import UNKNOWN
 
 Value = ast.LitValue
@@ -125,7 +125,7 @@ class ExprChecker(BuiltinChecks):
             return ast.Lit(e.value, span=e.span), BARE
         unit = UNITS.get(e.unit)
         if unit is None:
-            self.error(e.span, f"unknown unit '{e.unit}'{did_you_mean(e.unit, UNITS)}")
+            self.error(e.span, f"unknown unit '{e.unit}'{unit_suggestion(e.unit)}")
             return ast.Lit(e.value, span=e.span), ANY
         return ast.Lit(e.value * unit[0], span=e.span), num(unit[1])
 

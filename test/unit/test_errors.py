@@ -75,7 +75,7 @@ CASES = [
      (3, 41, "cannot add or subtract a speed and a time")),
     ("unknown unit",
      HEAD + "entity e { rules: r: topic /v.x > 3 m/min; }\nif (e.r) then { stop; }\n",
-     (3, 35, "unknown unit 'm/min'; did you mean 'min'?")),
+     (3, 35, "unknown unit 'm/min'; a speed is written in m/s, cm/s, km/h")),
     ("missing import",
      'import "nothere.yaml";\n' + HEAD + "entity e { rules: r: topic /v.x > 1; }\nif (e.r) then { stop; }\n",
      (1, 1, "cannot import '{dir}/nothere.yaml': no such file")),

@@ -281,12 +281,14 @@ def test_a_failed_start_names_its_lines_and_junit_parses(files, capsys, tmp_path
                       f"actual: start at 2.000 s, release at 3.000 s"
 
 
-def test_junit_that_cannot_be_written_still_prints_the_count(files, capsys):
+def test_junit_that_cannot_be_written_still_prints_the_count(files, tmp_path, capsys):
     path = files(FAILING)
-    code, out, err = run(capsys, path, "--junit", "/nonexistent/x.xml")
+    blocker = tmp_path / "blocker"
+    blocker.write_text("a file where the folder would be")  # missing folders are made now; this one cannot be
+    code, out, err = run(capsys, path, "--junit", str(blocker / "x.xml"))
     assert code == 2
     assert out.rstrip().splitlines()[-1] == "0 passed, 1 failed"
-    assert "rubass test: error: cannot write /nonexistent/x.xml" in err
+    assert f"rubass test: error: cannot write {blocker}/x.xml" in err
 
 
 # 11 -- covers entries that are no names -------------------------------------------------------------------------
