@@ -1,9 +1,12 @@
 """Recorded agent reports (`/rubass/agent_samples`) turned into node samples for replay.
 
-Pure: it wraps the stream of recorded messages. Each report becomes one node sample per spec
-node it covers, in the format of the monitor's `~node_samples`, on the topic SAMPLES; when an
-agent's reports stop for more than three of its periods (as the live monitor judges), the
-nodes it covered become unknown at that instant. Nodes that the monitor's own recorded
+Pure: it wraps the stream of recorded messages. The reports go into an AgentBook on the
+recording's clock, the book the live monitor keeps, so a node's values follow the live rule
+exactly: the freshest report containing the node among its host's fresh agents; unknown
+when none is fresh (more than three periods silent), when its agent left, or when it reports
+nothing for the node. After each report, and at each instant a report turns stale, every spec
+node the book knows gets a node sample (format of the monitor's `~node_samples`) on the topic
+SAMPLES if it is in that report or its value changed. Nodes that the monitor's own recorded
 samples cover are left to those: they are what the live engine saw.
 """
 from __future__ import annotations
@@ -12,7 +15,7 @@ import heapq
 import json
 from typing import Any, Dict, Iterable, Iterator, List, Optional, Set, Tuple
 
-from ..ros.agentbook import STALE_PERIODS, decode
+from ..ros.agentbook import AgentBook, decode, stale_at
 
 SAMPLES = "<agent samples>"
 Record = Tuple[float, str, Optional[Any]]
@@ -31,6 +34,39 @@ def _sample(node: str, alive: Any, cpu: Any, memory: Any) -> _Sample:
     return _Sample(json.dumps({"node": node, "alive": alive, "cpu": cpu, "memory": memory}))
 
 
+class _Replayed:
+    """The book on the recording's clock, and the last sample given for each spec node."""
+
+    def __init__(self, names: Dict[str, str], skip: Set[str]) -> None:
+        self.book = AgentBook(warn=lambda text: None)  # a replay reads past reports: nothing to warn about
+        self.names, self.skip = names, skip
+        self.hosts: Dict[str, str] = {}  # resolved node -> its host, from the latest entry naming it
+        self.given: Dict[str, Tuple[Any, Any, Any]] = {}
+        self.wakeups: List[float] = []
+
+    def add(self, stamp: float, text: str) -> Set[str]:
+        """A report into the book; the resolved nodes it contains (ValueError if it is not one)."""
+        report = decode(text)
+        self.book.update(report, stamp)
+        for node, n in report.nodes.items():
+            self.hosts[node] = n.host or report.host
+        if not report.leaving:
+            heapq.heappush(self.wakeups, stale_at(stamp, report.period))
+        return set() if report.leaving else set(report.nodes)
+
+    def samples(self, at: float, reported: Set[str]) -> Iterator[Record]:
+        for node, host in sorted(self.hosts.items()):
+            spec_name = self.names.get(node)
+            if spec_name is None or spec_name in self.skip:
+                continue
+            value = self.book.sample(node, host, at)
+            if spec_name not in self.given and value == (None, None, None):
+                continue  # nothing known of it yet: no sample
+            if node in reported or self.given.get(spec_name) != value:
+                self.given[spec_name] = value
+                yield at, SAMPLES, _sample(spec_name, *value)
+
+
 def agent_samples(stream: Iterable[Record], agent_topics: Set[str], names: Dict[str, str], skip: Set[str],
                   end: float) -> Iterator[Record]:
     """`stream` with each agent report replaced by node samples on SAMPLES.
@@ -38,17 +74,16 @@ def agent_samples(stream: Iterable[Record], agent_topics: Set[str], names: Dict[
     names: resolved node name -> the spec's name; skip: spec names left to the monitor's own
     samples; end: the recording's end (bag time), past which no expiry is emitted.
     """
-    covers: Dict[str, Tuple[float, List[str]]] = {}  # agent -> (stale at, spec nodes of its last report)
-    expiries: List[Tuple[float, str]] = []
+    state = _Replayed(names, skip)
+    done = -1.0
 
     def expire(until: float) -> Iterator[Record]:
-        while expiries and expiries[0][0] < until:
-            at, agent = heapq.heappop(expiries)
-            due = covers.get(agent)
-            if due is not None and due[0] == at:  # not superseded by a newer report
-                del covers[agent]
-                for node in due[1]:
-                    yield at, SAMPLES, _sample(node, None, None, None)
+        nonlocal done
+        while state.wakeups and state.wakeups[0] < until:
+            at = heapq.heappop(state.wakeups)
+            if at != done:  # several agents' reports may turn stale at one instant
+                done = at
+                yield from state.samples(at, set())
 
     for stamp, topic, msg in stream:
         yield from expire(stamp)
@@ -56,17 +91,8 @@ def agent_samples(stream: Iterable[Record], agent_topics: Set[str], names: Dict[
             yield stamp, topic, msg
             continue
         try:
-            report = decode(msg.data)
+            reported = state.add(stamp, msg.data)
         except (ValueError, AttributeError):
             continue
-        nodes = []
-        for resolved, n in sorted(report.nodes.items()):
-            spec_name = names.get(resolved)
-            if spec_name is None or spec_name in skip:
-                continue
-            nodes.append(spec_name)
-            yield stamp, SAMPLES, _sample(spec_name, n.alive, n.cpu, n.memory)
-        stale_at = stamp + STALE_PERIODS * report.period
-        covers[report.agent] = (stale_at, nodes)
-        heapq.heappush(expiries, (stale_at, report.agent))
+        yield from state.samples(stamp, reported)
     yield from expire(end)

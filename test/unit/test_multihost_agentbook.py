@@ -35,11 +35,13 @@ def test_bad_reports_say_what_is_wrong(text, words):
         decode(text)
 
 
-def test_unknown_values_and_nan_are_unknown():
+def test_unknown_values_are_unknown_and_nan_makes_the_entry_invalid():
     r = decode(json.dumps({"agent": "/a", "period": 0.1, "nodes": [
-        {"node": "/n", "alive": "yes", "cpu": float("nan"), "memory": None, "pid": True}]}))
+        {"node": "/n", "alive": "yes", "cpu": None, "memory": None, "pid": True},
+        {"node": "/m", "alive": True, "cpu": float("nan"), "memory": 1.0}]}))
     n = r.nodes["/n"]
     assert n.alive is None and n.cpu is None and n.memory is None and n.pid is None
+    assert "/m" not in r.nodes and "node /m" in r.invalid[0]  # NaN is no value (test_agentbook_m2_*)
 
 
 def test_lookup_uses_a_fresh_report_of_the_nodes_host():
