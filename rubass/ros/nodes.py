@@ -22,6 +22,7 @@ import rosgraph
 
 from ..engine.values import UNKNOWN
 from . import rpc
+from .pidcheck import PortOwners
 
 Submit = Callable[[str, float, Any, Any, Any], None]  # (spec node, ROS time, alive, cpu, memory)
 Remote = Callable[[str, str, int], Tuple[Any, Any, str]]  # (resolved node, host, pid) -> (cpu, memory, why)
@@ -163,6 +164,7 @@ class NodeSampler:
         self._looked_up: Dict[str, float] = {}  # monotonic time the master last gave each node's URI
         self._local = _local_addresses()
         self._hosts: Dict[str, bool] = {}
+        self.port_owners = PortOwners()  # does the pid a node gives own its XML-RPC port (pidcheck.py)
         self._stop = threading.Event()
         self._thread: Optional[threading.Thread] = None
         self._pool = concurrent.futures.ThreadPoolExecutor(max_workers=max(1, min(8, len(nodes))),
@@ -224,9 +226,13 @@ class NodeSampler:
         if alive is True and pid is not None:
             uri = self._uris.get(st.resolved, "")
             if self._is_local(urlparse(uri).hostname or ""):
-                note = why[len("alive"):]
-                cpu, memory, why = self._measure(pid)
-                why += note
+                wrong = self.port_owners.why_not(st.resolved, uri, pid)  # a node in a container: another pid
+                if wrong is not None:
+                    why = wrong
+                else:
+                    note = why[len("alive"):]
+                    cpu, memory, why = self._measure(pid)
+                    why += note
             elif self.remote is not None:
                 cpu, memory, why = self.remote(st.resolved, urlparse(uri).hostname or "", pid)
             else:
