@@ -15,7 +15,7 @@ from rubass_experiments.command import register as register_experiments
 from .ros.model_command import add_source_options, build_model
 from .ros.libtypes import after_check, after_failed_check
 from .ros.model_command import register as register_model
-from .lang.errors import Diagnostic
+from .lang.errors import Diagnostic, counted
 from .lang.source import SourceSet
 from .lang.sourcefile import read_source
 
@@ -25,11 +25,6 @@ def _print_diags(diags: Sequence[Diagnostic], sources: Optional[SourceSet]) -> i
     for d in diags:
         print(d.render(sources), file=sys.stderr)
     return sum(d.severity == "error" for d in diags)
-
-
-def _count(n: int, noun: str) -> str:
-    """'1 node', '2 nodes'."""
-    return f"{n} {noun}{'' if n == 1 else 's'}"
 
 
 def cmd_check(args: argparse.Namespace) -> int:
@@ -45,19 +40,19 @@ def cmd_check(args: argparse.Namespace) -> int:
             lib_errors, warnings, lib_sources = after_failed_check(path, args.actions, model)
             # the summary counts every error printed above it: the spec's, and its libraries'
             n = sum(d.severity == "error" for d in exc.diagnostics) + _print_diags(warnings + lib_errors, lib_sources)
-            print(f"{path}: {_count(n, 'error')}", file=sys.stderr)
+            print(f"{path}: {counted(n, 'error')}", file=sys.stderr)
             status = 1
             continue
         errors, warnings = after_check(checked, model)
         n = _print_diags(checked.warnings + warnings, checked.sources) + _print_diags(errors, checked.sources)
         if errors or n:
-            print(f"{path}: {_count(max(n, len(errors)), 'error')}", file=sys.stderr)
+            print(f"{path}: {counted(max(n, len(errors)), 'error')}", file=sys.stderr)
             status = 1
             continue
         if not args.quiet:
-            print(f"{path}: ok ({_count(len(checked.rules), 'rule')}, {_count(len(checked.behaviours), 'behaviour')}, "
-                  f"{_count(len(spellings(checked.topics)), 'topic')}, {_count(len(checked.nodes), 'node')}, "
-                  f"{_count(len(checked.actions), 'action')})")
+            print(f"{path}: ok ({counted(len(checked.rules), 'rule')}, {counted(len(checked.behaviours), 'behaviour')}, "
+                  f"{counted(len(spellings(checked.topics)), 'topic')}, {counted(len(checked.nodes), 'node')}, "
+                  f"{counted(len(checked.actions), 'action')})")
     return status
 
 

@@ -8,6 +8,7 @@ from dataclasses import dataclass, field
 from typing import Any, Dict, List, Sequence, Tuple
 
 from ..lang import ast
+from ..lang.errors import counted
 from ..lang.model import CheckedSpec
 
 OK, WARN, ERROR = 0, 1, 2  # DiagnosticStatus levels
@@ -95,7 +96,11 @@ def build(spec: CheckedSpec, rules: Dict[str, Any], active: List[int], topics: D
     if monitor.get("data errors", "none") != "none":  # a rule that cannot read its field protects nothing
         level = ERROR
         msg_latch += f" (DATA ERROR: {monitor['data errors']})"
-    msg = f"enforcing {spec.path}: {len(spec.rules)} rules, {len(spec.behaviours)} behaviours"
+    live = monitor.get("spec errors against the live types", "none")
+    if live != "none":  # the spec has an error `rubass check --live` would give; the rule still runs on its numbers
+        level = ERROR
+        msg_latch += f" (SPEC ERROR against the live message types: {live})"
+    msg = f"enforcing {spec.path}: {counted(len(spec.rules), 'rule')}, {counted(len(spec.behaviours), 'behaviour')}"
     if monitor.get("overloaded", "no") != "no":
         level = ERROR
         msg += f" (OVERLOADED, dropping messages: {monitor['overloaded']})"

@@ -55,6 +55,11 @@ class SpecError(RubassError):
         return "\n".join(d.render(self.sources) for d in self.diagnostics)
 
 
+def counted(n: int, noun: str) -> str:
+    """'1 rule', '2 rules' (a noun whose plural takes an s)."""
+    return f"{n} {noun}{'' if n == 1 else 's'}"
+
+
 def a_noun(noun: str) -> str:
     """The noun with its indefinite article: 'a time', 'an entity', 'a quantity in m*s'."""
     if not noun.replace(" ", "").isalpha():  # a formula of units, such as m*s or m^3

@@ -47,6 +47,7 @@ from std_srvs.srv import Trigger, TriggerResponse
 from ..engine import Engine, Event
 from ..engine.loop import EngineLoop, Message, NodeSample
 from ..lang import SpecError, load_spec
+from ..lang.errors import counted
 from ..lang.library import priority_conflicts
 from ..lang.model import CheckedSpec
 from ..actions import status as status_mod
@@ -57,6 +58,7 @@ from ..actions.runner import ActionRunner
 from ..actions.dispatch import Dispatcher
 from .master_watch import MasterWatch
 from .libtypes import after_check
+from .livecheck import LiveTypeCheck
 from .nodes import NodeSampler
 from .outputs import Outputs
 from ..actions.overload import OverloadGuard
@@ -246,12 +248,14 @@ class Monitor(Reloading):
         self.keeper.save(engine, self.dispatcher.orphans, self._fail_safes())
         self.watcher = TopicWatcher(self._on_message, _log, self._on_spellings)
         self.watcher.sync(spec)
+        self.livecheck = LiveTypeCheck(_log)  # the spec against the types its topics turn out to carry
         self.agents = AgentBook()  # cpu and memory of nodes on other hosts, from their agents
         self._agent_sub = rospy.Subscriber(AGENT_TOPIC, String, self._on_agent, queue_size=100, tcp_nodelay=True)
         self.sampler = self._sampler(spec)
         self.load_error = ""
-        rospy.loginfo("rubass: enforcing %s (%d rules, %d behaviours, %d topics, %d nodes)", spec.path,
-                      len(spec.rules), len(spec.behaviours), len(self.watcher.topics), len(spec.nodes))  # distinct
+        rospy.loginfo("rubass: enforcing %s (%s)", spec.path, ", ".join(  # distinct topics
+            counted(n, noun) for n, noun in ((len(spec.rules), "rule"), (len(spec.behaviours), "behaviour"),
+                                             (len(self.watcher.topics), "topic"), (len(spec.nodes), "node"))))
         threading.Thread(target=self._engine_thread, name="rubass-engine", daemon=True).start()
 
     def _install_control(self) -> None:
@@ -383,6 +387,8 @@ class Monitor(Reloading):
 
         rules, active, field_errors = loop.call(snapshot)
         data_errors = loop.call(self._data_errors)
+        self.livecheck.use(self.spec, self.config.actions)  # after a reload: the new spec
+        self.livecheck.note(self.watcher.carried_types())
         topics = {name: {"messages": s.messages, "errors": s.errors, "type": s.type}
                   for s in self.watcher.status() for name in (s.spec_name,) + s.aliases}  # every spelling
         nodes = {s.spec_name: {"why": s.why} for s in self.sampler.status.values()}
@@ -409,6 +415,8 @@ class Monitor(Reloading):
             monitor["dropped by topic"] = ", ".join(f"{t} {n}" for t, n in sorted(loop.dropped_by_topic.items()))
         monitor["last start"] = getattr(self.dispatcher, "last_start", "none")  # with its witnesses
         monitor["data errors"] = "; ".join(data_errors) or "none"
+        monitor["spec errors against the live types"] = "; ".join(e.splitlines()[0] for e in self.livecheck.errors) \
+            or "none"
         if self.error_guard.active:
             monitor["data error actions"] = "running " + ", ".join(self.error_guard.actions)
         assert self.spec is not None
@@ -447,9 +455,11 @@ class Monitor(Reloading):
         self.master_watch.stop()
         loop.stop()
         self.sampler.stop()
+        self.livecheck.close()
         received = sum(st.messages for st in self.watcher.status())
-        rospy.loginfo("rubass: stopped after %d messages (%d dropped: the engine's queue was full), %d reloads",
-                      received, loop.dropped, self.reloads)
+        dropped = f"{loop.dropped} dropped because the engine's queue was full" if loop.dropped else "none dropped"
+        rospy.loginfo("rubass: stopped after %s (%s), %s", counted(received, "message"), dropped,
+                      counted(self.reloads, "reload"))
         # the releases are handed to the actions' threads; what follows unregisters from rospy, which
         # may wait for good for a master that does not answer (a registration holds its lock)
         exit_within(EXIT_GRACE + 1.0 * len(self.runners))

@@ -14,7 +14,7 @@ import rospy
 from ..actions.runner import ActionRunner
 from ..engine import Engine, Event
 from ..lang import SpecError, load_spec
-from ..lang.errors import RubassError
+from ..lang.errors import RubassError, counted
 from ..lang.model import CheckedSpec
 from .gcfreeze import freeze_heap
 from .topics import ros_now
@@ -87,7 +87,8 @@ class Reloading:
                     self.reloads += 1
                     self.last_reload_error = ""
                     freeze_heap()
-                    return True, f"enforcing {spec.path}: {len(spec.rules)} rules, {len(spec.behaviours)} behaviours"
+                    return True, (f"enforcing {spec.path}: {counted(len(spec.rules), 'rule')}, "
+                                  f"{counted(len(spec.behaviours), 'behaviour')}")
                 if spec.behaviours == [] and self.spec.behaviours:
                     raise StartupError(f"{spec.path}: the new spec has no behaviours; refusing to drop every "
                                        f"safety behaviour of the running spec (was the file caught half-written? "
@@ -152,7 +153,8 @@ class Reloading:
             rospy.loginfo("rubass: reloaded %s (%s) in %.0f ms: %d rules, %d behaviours (check %.0f ms, build %.0f ms, "
                           "swap %.1f ms)", spec.path, reason, ms, len(spec.rules), len(spec.behaviours),
                           (t_check - t0) * 1000, (t_build - t_check) * 1000, (t_swap - t_build) * 1000)
-            return True, f"reloaded in {ms:.0f} ms: {len(spec.rules)} rules, {len(spec.behaviours)} behaviours"
+            return True, (f"reloaded in {ms:.0f} ms: {counted(len(spec.rules), 'rule')}, "
+                          f"{counted(len(spec.behaviours), 'behaviour')}")
 
     def _load_stable(self) -> CheckedSpec:
         """load_spec, again if a file changed while it was read or within the last 50 ms (an

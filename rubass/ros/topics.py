@@ -341,6 +341,15 @@ class TopicWatcher:
         with self._lock:
             return list(self.topics.values())
 
+    def carried_types(self) -> Dict[str, Tuple[str, str]]:
+        """Spec topic name (every spelling) -> (type, full definition) of the type evaluated on it."""
+        out: Dict[str, Tuple[str, str]] = {}
+        for s in self.status():
+            text = getattr(s.cls, "_full_text", None)
+            if isinstance(text, str):
+                out.update({name: (s.type, text) for name in (s.spec_name,) + s.aliases})
+        return out
+
 
 def scalar_paths(spec: CheckedSpec) -> Dict[str, Set[Tuple[ast.PathElem, ...]]]:
     """topic -> the field paths the spec uses as one value (compared, computed with, a condition),

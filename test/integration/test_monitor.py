@@ -109,7 +109,7 @@ def test_reload_service_reports_rejection(ros, tmp_path):
     assert "success: False" in out.stdout and "expected expression" in out.stdout
     spec(tmp_path, "entity a { rules: r: topic /x.data > 2; }\nif (a.r) then { brake; }\n")
     out = ros.call("/rubass/reload")
-    assert "success: True" in out.stdout and "1 rules, 1 behaviours" in out.stdout
+    assert "success: True" in out.stdout and "1 rule, 1 behaviour" in out.stdout
 
 
 def test_serial_action_writes_into_a_pty(ros, tmp_path):
