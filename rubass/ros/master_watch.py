@@ -35,6 +35,8 @@ from rospy.impl.registration import RegManager, get_registration_listeners, get_
 from . import rpc
 
 Log = Callable[[str, str], None]
+MONITOR_UNREACHABLE = ("existing connections keep working and the rules keep being enforced; nodes started now "
+                       "cannot connect to the monitor until the master is back")
 
 
 @dataclass
@@ -83,8 +85,10 @@ class MasterWatch:
     forgotten it. `state` and the counters feed the monitor's /diagnostics."""
 
     def __init__(self, caller_id: str, node_uri: str, master_uri: str, period: float, log: Log,
-                 timeout: float = 0.5) -> None:
+                 timeout: float = 0.5, unreachable: str = MONITOR_UNREACHABLE) -> None:
+        """`unreachable`: what the warning logged when the master stops answering says it means."""
         self.caller_id, self.node_uri, self.master_uri = caller_id, node_uri, master_uri
+        self.unreachable = unreachable
         self.period, self.timeout, self.log = period, timeout, log
         self.state = "connected"
         self.reregistrations = 0
@@ -124,9 +128,7 @@ class MasterWatch:
             # (its /rosout goes there) until the link is back, and /diagnostics must say it meanwhile
             self.state = f"unreachable for {time.monotonic() - self.down_since:.1f} s"
             if first:
-                self.log("warn", f"the master at {self.master_uri} cannot be reached ({exc}): existing connections "
-                                 f"keep working and the rules keep being enforced; nodes started now cannot "
-                                 f"connect to the monitor until the master is back")
+                self.log("warn", f"the master at {self.master_uri} cannot be reached ({exc}): {self.unreachable}")
             return "unreachable"
         was_down, self.down_since = self.down_since, None
         was_pid, self.master_pid = self.master_pid, pid
