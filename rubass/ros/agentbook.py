@@ -190,8 +190,9 @@ class AgentBook:
     def update(self, report: AgentReport, at: float) -> None:
         if report.invalid and at - self._warned.get(report.agent, -math.inf) >= WARN_EVERY:
             self._warned[report.agent] = at
-            self.warn(f"rubass: ignoring {len(report.invalid)} entries of a report on {AGENT_TOPIC}: "
-                      + "; ".join(report.invalid))
+            n = len(report.invalid)
+            self.warn(f"rubass: ignoring {n} entr{'y' if n == 1 else 'ies'} of a report on {AGENT_TOPIC} "
+                      f"(no value: as if not reported): " + "; ".join(report.invalid))
         with self._lock:
             old = self._agents.pop(report.agent, None)
             self._left.pop(report.agent, None)
