@@ -264,13 +264,20 @@ class AgentBook:
     def _prune(self, at: float) -> List[_Heard]:
         """Drop agents silent for COVERED_DROP_AFTER whose host another fresh agent reports (an
         agent relaunched under a new name); the agents heard, by name."""
+        dropped = []
         with self._lock:
             heard = list(self._agents.values())
-            fresh_hosts = {h.report.host for h in heard if at < h.stale_at and h.report.host}
+            fresh = {h.report.host: h.report.agent for h in heard if at < h.stale_at and h.report.host}
             for h in heard:
-                if h.report.host in fresh_hosts and at >= h.stale_at + COVERED_DROP_AFTER:
+                if h.report.host in fresh and at >= h.stale_at + COVERED_DROP_AFTER:
                     del self._agents[h.report.agent]
-            return sorted(self._agents.values(), key=lambda h: h.report.agent)
+                    dropped.append(f"rubass: agent {h.report.agent} on {h.report.host} has been silent for "
+                                   f"{at - h.at:.1f} s while {fresh[h.report.host]} reports its host: "
+                                   f"dropped from the list of agents")
+            kept = sorted(self._agents.values(), key=lambda h: h.report.agent)
+        for text in dropped:
+            self.warn(text)
+        return kept
 
     def conflicts(self, at: float) -> List[str]:
         """'agents /a and /b both report host H' for every host more than one fresh agent claims."""

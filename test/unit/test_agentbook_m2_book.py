@@ -102,7 +102,8 @@ def test_the_last_agent_of_a_host_leaving_makes_its_nodes_unknown_with_the_reaso
 
 
 def test_a_silent_agent_whose_host_another_agent_covers_is_said_then_dropped():
-    book = AgentBook(warn=lambda text: None)
+    warned = []
+    book = AgentBook(warn=warned.append)
     book.update(report("/rubass_agent_b_1"), 10.0)  # relaunched under a new anonymous name
     for i in range(1, 400):
         book.update(report("/rubass_agent_b_2"), 10.0 + i * 0.1)
@@ -111,6 +112,8 @@ def test_a_silent_agent_whose_host_another_agent_covers_is_said_then_dropped():
     said = book.silent(10.5)
     assert len(said) == 1 and said[0].startswith("/rubass_agent_b_1 on 10.218.0.2") and "/rubass_agent_b_2" in said[0]
     assert book.silent(now) == [] and "_b_1" not in book.summary(now)
+    assert len(warned) == 1 and "agent /rubass_agent_b_1 on 10.218.0.2 has been silent" in warned[0]
+    assert "/rubass_agent_b_2 reports its host: dropped" in warned[0]
     assert now >= 10.3 + COVERED_DROP_AFTER
 
 
