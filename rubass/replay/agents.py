@@ -49,16 +49,15 @@ class _Replayed:
         report = decode(text)
         self.book.update(report, stamp)
         for node, n in report.nodes.items():
-            self.hosts[node] = n.host or report.host
+            if self.names.get(node) is not None and self.names[node] not in self.skip:  # only the spec's nodes
+                self.hosts[node] = n.host or report.host
         if not report.leaving:
             heapq.heappush(self.wakeups, stale_at(stamp, report.period))
         return set() if report.leaving else set(report.nodes)
 
     def samples(self, at: float, reported: Set[str]) -> Iterator[Record]:
         for node, host in sorted(self.hosts.items()):
-            spec_name = self.names.get(node)
-            if spec_name is None or spec_name in self.skip:
-                continue
+            spec_name = self.names[node]
             value = self.book.sample(node, host, at)
             if spec_name not in self.given and value == (None, None, None):
                 continue  # nothing known of it yet: no sample
