@@ -33,7 +33,7 @@ from ..engine.values import UNKNOWN
 AGENT_TOPIC = "/rubass/agent_samples"
 STALE_PERIODS = 3.0
 COVERED_DROP_AFTER = 30.0  # s: a silent agent whose host another fresh agent reports is listed this long, then dropped
-WARN_EVERY = 10.0  # s: at most one warning per agent this often about its invalid entries
+WARN_EVERY = 10.0  # s: at most one warning this often about invalid entries (whichever agent sends them)
 _LOOPBACK = ("127.", "::1", "localhost")
 
 
@@ -183,13 +183,13 @@ class AgentBook:
     def __init__(self, warn: Optional[Callable[[str], None]] = None) -> None:
         self._agents: Dict[str, _Heard] = {}
         self._left: Dict[str, _Left] = {}
-        self._warned: Dict[str, float] = {}
+        self._warned = -math.inf  # when invalid entries were last warned about
         self._lock = threading.Lock()
         self.warn: Callable[[str], None] = warn if warn is not None else _ROSOUT.warning
 
     def update(self, report: AgentReport, at: float) -> None:
-        if report.invalid and at - self._warned.get(report.agent, -math.inf) >= WARN_EVERY:
-            self._warned[report.agent] = at
+        if report.invalid and at - self._warned >= WARN_EVERY:
+            self._warned = at
             n = len(report.invalid)
             self.warn(f"rubass: ignoring {n} entr{'y' if n == 1 else 'ies'} of a report on {AGENT_TOPIC} "
                       f"(no value: as if not reported): " + "; ".join(report.invalid))
