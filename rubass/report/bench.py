@@ -3,6 +3,7 @@ run), else the developers' figures in bench/README.md (their machine, their date
 from __future__ import annotations
 
 import json
+import math
 import os
 import re
 from dataclasses import dataclass
@@ -46,6 +47,17 @@ _EXPECTED = ('expected the JSON lines of bench/reaction.py, e.g. {"benchmark": "
              '"rubass": {"p50_ms": 0.4, "p99_ms": 0.9, "max_ms": 1.2}}')
 
 
+def _no_bound(obj: dict, rb: dict) -> str:
+    """Why a case's figures bound nothing ('' when they do): violations without their stop, extra stops
+    (stops are matched to violations in order, so one extra shifts every later pair), no figure."""
+    missed, extra = obj.get("rubass_unanswered", 0), obj.get("rubass_extra_stops", 0)
+    if missed != 0:
+        return f"has {missed} violations that got no stop"
+    if extra != 0:
+        return f"has {extra} extra stops"
+    return "measured no reaction (max_ms is null)" if rb.get("max_ms") is None else ""
+
+
 def from_json_lines(path: str) -> Reaction:
     """The output of `bench/reaction.py` (JSON lines). Raises BenchError when the file cannot be read or
     holds no reaction figure (lines that are no JSON are skipped while some line holds figures)."""
@@ -67,14 +79,22 @@ def from_json_lines(path: str) -> Reaction:
             first_bad = first_bad or f"line {number} is not JSON"
             continue
         rb = obj.get("rubass") if isinstance(obj, dict) and obj.get("benchmark") == "reaction" else None
-        if not isinstance(rb, dict) or rb.get("max_ms") is None:
+        if not isinstance(rb, dict):
             first_bad = first_bad or f"line {number} holds no reaction figures"
             continue
+        why = _no_bound(obj, rb)  # a case whose stops did not all come, or not one each, bounds nothing
+        if why:
+            case = f"{obj.get('rate_hz', '?')} Hz{', loaded' if obj.get('background_load') else ''}"
+            raise BenchError(f"{path}:{number}: the case at {case} {why}: its latencies are no upper bound "
+                             f"of the monitor's reaction; measure again")
         try:
             figures = float(rb["max_ms"]), float(rb["p99_ms"]), float(rb["p50_ms"])
         except (KeyError, TypeError, ValueError):
             raise BenchError(f"{path}:{number}: a reaction needs the numbers max_ms, p99_ms and p50_ms "
                              f"under \"rubass\"") from None
+        if not all(math.isfinite(f) for f in figures):
+            raise BenchError(f"{path}:{number}: a reaction figure is not a finite number: no upper bound; "
+                             f"measure again")
         worst, p99, p50 = max(worst, figures[0]), max(p99, figures[1]), max(p50, figures[2])
         n += 1
     if not n:

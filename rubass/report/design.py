@@ -43,7 +43,22 @@ class Design:
         """'0.4 s + 1 s', 'immediate', or 'not computed: …'."""
         if self.unknown:
             return "not computed: " + "; ".join(self.unknown)
-        return " + ".join(f"{v:g} s" for v in self.chain) if self.chain else "immediate"
+        return " + ".join(f"{up(v)} s" for v in self.chain) if self.chain else "immediate"
+
+
+def up(x: float, digits: int = 6) -> str:
+    """x in at most `digits` significant digits, rounded up: a bound printed is never below the bound
+    (1/3 s is '0.333334', not '0.333333')."""
+    text = f"{x:.{digits}g}"
+    if x <= 0 or not math.isfinite(x) or float(text) >= x * (1 - 1e-12):  # 0.1 + 0.2 is 0.3, not 0.300001
+        return text
+    step = 10.0 ** (math.floor(math.log10(x)) - digits + 1)
+    for _ in range(3):  # a float product may land just below: step on
+        text = f"{math.ceil(x / step) * step:.{digits}g}"
+        if float(text) >= x:
+            break
+        x += step / 2
+    return text
 
 
 def slowest(designs: List[Design]) -> Design:
@@ -74,8 +89,12 @@ def design(spec: CheckedSpec, expr: ast.Expr, seen: FrozenSet[Any] = frozenset()
             return Design()
         return design(spec, spec.rule(expr.key).expr, seen | {expr.key}, true)
     if isinstance(expr, ast.Active):  # started (or released) by the slowest behaviour with the action
-        return slowest([design(spec, b.cond, seen | {b.index}, true) for b in spec.behaviours
-                        if b.index not in seen and any(a.name == expr.action for a in b.actions)])
+        holders = [b for b in spec.behaviours if b.index not in seen and any(a.name == expr.action for a in b.actions)]
+        latched = [b.label for b in holders if b.latched]
+        if latched and not true:  # a latched behaviour holds its actions until ~reset, whatever its condition
+            return Design(unknown=[f"active({expr.action}) is held by {', '.join(latched)}, latched: it is released "
+                                   f"only by ~reset"])
+        return slowest([design(spec, b.cond, seen | {b.index}, true) for b in holders])
     if isinstance(expr, ast.NodeStat):
         return Design([NODE_SAMPLE])
     if isinstance(expr, (ast.Quant, ast.Zone)) and _has_time(expr):

@@ -8,7 +8,7 @@ from html import escape
 from typing import Any, Iterable, List, Sequence
 
 from ..lang import ast
-from .design import design
+from .design import design, up
 from .evidence import Evidence, attrs, behaviour_label, hazards_via_rules, rule_ids_of, spec_text
 from .timeline import svg
 
@@ -164,7 +164,7 @@ def _rules(ev: Evidence) -> str:
     worst = ev.reaction.worst_ms if ev.reaction else None
     for r in ev.spec.rules:
         d = design(ev.spec, ast.RuleRef(r.key))  # through the rules it uses
-        bound = _e(d.text()) + (f" + ≤ {worst:g} ms = ≤ {d.total + worst / 1000:.4g} s"
+        bound = _e(d.text()) + (f" + ≤ {worst:g} ms = ≤ {up(d.total + worst / 1000)} s"
                                 if worst is not None and not d.unknown else "")
         rows.append(f"<tr><td><code>{_e(r.key)}</code></td><td>{_rule_id(ev, r)}</td><td>{_attr(r, 'hazard')}</td>"
                     f"<td>{_attr(r, 'title')}</td><td>{_attr(r, 'ref')}</td><td>{bound}</td>"

@@ -62,9 +62,10 @@ def init_node(name: str, argv: Optional[List[str]], rospy_signals: bool, say: Ca
             rospy.core.register_signals()
         return None
     say(failed or f"stopped before the ROS master at {uri} answered; nothing was started")
-    exit_within(STOP_GRACE)
+    code = 1 if failed else 0
+    exit_within(STOP_GRACE, code, "nothing had been started")
     rospy.signal_shutdown("stopped before start")
-    return 1 if failed else 0
+    return code
 
 
 def _wait_for_master(uri: str, say: Callable[[str], None]) -> None:

@@ -1,0 +1,84 @@
+"""The report's reaction figures are upper bounds or absent: a benchmark case whose violations did
+not all get their own stop bounds nothing; a printed figure is rounded up, never down; a latched
+action's `not active()` has no time by design (only ~reset releases it)."""
+import re
+
+import pytest
+
+from rubass.cli import main
+from rubass.lang import check_text
+from rubass.report.bench import BenchError, from_json_lines
+from rubass.report.design import design, up
+from rubass.lang import ast
+
+CASE = ('{{"benchmark": "reaction", "rate_hz": 100, "background_load": false, '
+        '"rubass": {{"p50_ms": 0.5, "p99_ms": 0.9, "max_ms": {max}}}, "rubass_unanswered": {missed}, '
+        '"rubass_extra_stops": {extra}}}\n')
+
+
+def _bench(write, *cases):
+    return write("reaction.jsonl", "".join(CASE.format(**c) for c in cases))
+
+
+def test_a_clean_case_is_its_own_bound(write):
+    r = from_json_lines(_bench(write, dict(max=1.2, missed=0, extra=0), dict(max=3.4, missed=0, extra=0)))
+    assert (r.worst_ms, r.cases) == (3.4, 2)
+
+
+@pytest.mark.parametrize("bad,why", [
+    (dict(max=1.2, missed=50, extra=0), "has 50 violations that got no stop"),
+    (dict(max=1.2, missed=0, extra=1), "has 1 extra stops"),
+    (dict(max="null", missed=0, extra=0), "measured no reaction"),
+    (dict(max="NaN", missed=0, extra=0), "not a finite number"),
+])
+def test_a_case_that_bounds_nothing_is_an_error_not_skipped(write, bad, why):
+    path = _bench(write, dict(max=1.2, missed=0, extra=0), bad)
+    with pytest.raises(BenchError) as err:
+        from_json_lines(path)
+    assert f"{path}:2:" in str(err.value) and why in str(err.value), str(err.value)
+
+
+@pytest.mark.parametrize("x,shown", [(1 / 3, "0.333334"), (1000.0646, "1000.07"), (0.1 + 0.2, "0.3"), (2.0, "2"),
+                                     (10.0646, "10.0646")])
+def test_a_figure_is_rounded_up(x, shown):
+    assert up(x) == shown and float(shown) >= x * (1 - 1e-12)
+
+
+LIB = "actions:\n  stop: {plugin: log, level: warn, latch: true}\n  warn: {plugin: log, level: info}\n"
+SPEC = """import "lib.yaml";
+action primitive stop, warn;
+entity e {
+  rules:
+    fast: (topic /a.data > 1) for 1 s;
+    resumed: not active(stop);
+    resumed_for: (not active(stop)) for 2 s;
+    slow_age: 3 * age(topic /a) > 1 s;
+    long: (topic /a.data > 0) for 1000 s;
+}
+if (e.fast) then { stop; }
+if (e.resumed_for) then { warn; }
+if (e.slow_age or e.long) then { warn; }
+"""
+
+
+def test_not_active_of_a_latched_action_has_no_time_by_design(write):
+    write("lib.yaml", LIB)
+    spec = check_text(SPEC, write("s.rbs", SPEC))
+    for key in ("e.resumed", "e.resumed_for"):
+        d = design(spec, ast.RuleRef(key))
+        assert d.unknown and "latched" in d.unknown[0] and "~reset" in d.unknown[0], (key, d)
+    assert design(spec, ast.RuleRef("e.fast")).chain == [1.0]
+
+
+def test_the_page_rounds_its_totals_up(write, tmp_path, capsys):
+    write("lib.yaml", LIB)
+    path = write("s.rbs", SPEC)
+    bench = _bench(write, dict(max=64.6, missed=0, extra=0))
+    out = str(tmp_path / "r.html")
+    main(["report", path, "--bench", bench, "-o", out])
+    capsys.readouterr()
+    html = open(out, encoding="utf-8").read()
+    rows = {m.group(1): m.group(0) for m in re.finditer(r"<tr><td><code>(e\.\w+)</code>.*?</tr>", html, re.S)}
+    assert "1000 s + ≤ 64.6 ms = ≤ 1000.07 s" in rows["e.long"], rows["e.long"]
+    assert "0.333334 s + ≤ 64.6 ms = ≤ 0.397934 s" in rows["e.slow_age"], rows["e.slow_age"]
+    assert "not computed" in rows["e.resumed"] and "latched" in rows["e.resumed"]
