@@ -152,17 +152,36 @@ def unit_suggestion(unit: str) -> str:
     close). A compound unit is suggested whole: 'm/sec' -> 'm/s', not the 'sec' a spelling match finds."""
     import difflib
 
-    meant = _compound(unit) if "/" in unit else None
-    if meant is not None:
+    import re
+
+    if any(not re.fullmatch(r"0*[1-9]\d*", power) for power in re.findall(r"\^([^/*]*)", unit)):
+        return ""  # 's^0', 's^-1', 's^x': no unit of rubass means it, and none is as good as a wrong one
+    meant = _compound(unit) if "/" in unit else _unit_part(unit) if "^" in unit else None
+    if meant is not None:  # its dimension is known: only a unit of that dimension is suggested
         same = [u for u, (f, d) in UNITS.items() if d == meant[1]]
         exact = [u for u in same if abs(UNITS[u][0] - meant[0]) <= 1e-9 * meant[0]]
         if exact:
             return f"; did you mean '{exact[0]}'?"
         if same:
             return f"; a {dimension_name(meant[1])} is written in {', '.join(same)}"
+        return ""  # 's^2/m': the inverse 'm/s^2' is spelt alike but means something else
     alone = _SPELLINGS.get(unit, _SPELLINGS.get(unit.lower()))
     if alone is not None:
         return f"; did you mean '{alone}'?"
-    pool = sorted(u for u in UNITS if ("/" in u) == ("/" in unit)) or sorted(UNITS)
+    pool = sorted(u for u in UNITS if ("/" in u) == ("/" in unit) and _parts_agree(unit, u)) or \
+        sorted(u for u in UNITS if _parts_agree(unit, u))
     close = difflib.get_close_matches(unit, pool, n=1, cutoff=0.6)
     return f"; did you mean '{close[0]}'?" if close else ""
+
+
+def _parts_agree(unit: str, candidate: str) -> bool:
+    """Whether `candidate` may be what `unit` meant: each part of `unit` rubass reads ('m' of 'm/s2') has the
+    dimension of the candidate's part in its place (so 's2/m' is never 'm/s^2')."""
+    mine, theirs = unit.split("/"), candidate.split("/")
+    if len(mine) != len(theirs):
+        return False  # 'm/s/s' is no 'm/s'
+    for a, b in zip(mine, theirs):
+        known, other = _unit_part(a), UNITS.get(b) or _unit_part(b)
+        if known is not None and (other is None or other[1] != known[1]):
+            return False
+    return True
