@@ -25,13 +25,18 @@ def test_a_local_node_is_measured_from_the_second_sample(tmp_path):
     import os
 
 
+    import socket
+
     got = []
     sampler = NodeSampler([("me", "/me")], lambda *a: got.append(a), lambda: 1.0, 0.1, "/rubass")
     sampler._ask = lambda name: (True, os.getpid(), "alive")
-    sampler._uris["/me"] = "http://127.0.0.1:40000/"
-    st = NodeStatus("me", "/me")
-    sampler.sample(st)
-    sampler.sample(st)
+    with socket.socket() as port:  # the pid a node gives must listen on its URI's port (pidcheck.py)
+        port.bind(("127.0.0.1", 0))
+        port.listen()
+        sampler._uris["/me"] = f"http://127.0.0.1:{port.getsockname()[1]}/"
+        st = NodeStatus("me", "/me")
+        sampler.sample(st)
+        sampler.sample(st)
     assert got[0][3] is UNKNOWN and got[0][4] > 1e6  # the first CPU reading only starts the count
     assert isinstance(got[1][3], float) and got[1][4] > 1e6
 
@@ -196,14 +201,17 @@ def test_cpu_of_a_busy_process_is_not_quantized_to_ten_percent_steps():
     import sys
     import time
 
-    busy = subprocess.Popen([sys.executable, "-c", "while True: pass"])
+    busy = subprocess.Popen([sys.executable, "-c", "import socket\ns = socket.socket()\ns.bind(('127.0.0.1', 0))\n"
+                             "s.listen()\nprint(s.getsockname()[1], flush=True)\nwhile True: pass"],
+                            stdout=subprocess.PIPE, text=True)  # it listens on its URI's port, as a node does
     try:
         from rubass.ros.nodes import _schedstat_seconds
 
+        port = int(busy.stdout.readline())
         got = []
         sampler = NodeSampler([("b", "/b")], lambda *a: got.append(a[3]), lambda: 1.0, 0.1, "/rubass")
         sampler._ask = lambda name: (True, busy.pid, "alive")
-        sampler._uris["/b"] = "http://127.0.0.1:40000/"
+        sampler._uris["/b"] = f"http://127.0.0.1:{port}/"
         st = NodeStatus("b", "/b")
         sampler.sample(st)  # the first reading only starts the count
         used0, t0 = _schedstat_seconds(busy.pid), time.monotonic()
@@ -221,6 +229,7 @@ def test_cpu_of_a_busy_process_is_not_quantized_to_ten_percent_steps():
     finally:
         busy.kill()
         busy.wait()
+        busy.stdout.close()
 
 
 def test_topics_read_only_by_age_are_never_deserialised():
