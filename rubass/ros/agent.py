@@ -80,9 +80,11 @@ class Agent:
     """Discovers the nodes on this host and samples them; `step()` returns one report.
 
     Each node is sampled by a pending task of its own and a report never waits for a slow one:
-    it carries each node's latest completed sample, and a node whose sample has been under way
-    longer than the monitor accepts a report (STALE_PERIODS periods) reads unknown, with why.
-    No second sample of a node starts while one is under way."""
+    it carries each node's latest completed sample. A node whose sample has been under way longer
+    than the monitor accepts a report (STALE_PERIODS periods) beyond the getPid timeout reads
+    unknown, with why: within the timeout a slow answer is a busy node (a CPU hog answers late),
+    and a node that does not answer by then is read alive false by its own sample. No second
+    sample of a node starts while one is under way."""
 
     def __init__(self, name: str, host: str, master_uri: str, period: float, log: Log, timeout: float = 0.1,
                  cache_file: Optional[str] = None) -> None:
@@ -207,7 +209,7 @@ class Agent:
                 started.append(future)
         if started:
             concurrent.futures.wait(started, timeout=SAMPLE_WAIT * self.period)
-        at, limit = time.monotonic(), STALE_PERIODS * self.period
+        at, limit = time.monotonic(), STALE_PERIODS * self.period + self.sampler.timeout
         uris = self.sampler._uris
         with self._lock:
             latest = dict(self._latest)

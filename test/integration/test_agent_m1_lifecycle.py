@@ -84,9 +84,10 @@ def test_a_hung_node_does_not_delay_the_reports_at_50_hz(ros):
     assert len(measured) >= 0.9 * len(during), [entry(r, "/healthy") for r in during][:5]
     hung = [entry(r, "/frozen") for r in during]
     assert all(h["cpu"] is None and h["alive"] is not True for h in hung), hung[:5]
-    # under way longer than the monitor accepts (3 periods, 60 ms): unknown, and why
-    assert any(h["alive"] is None and h["why"].startswith("no answer from the node for ") for h in hung), hung[:5]
-    assert any(h["alive"] is False and "did not answer getPid" in h["why"] for h in hung), hung[:5]
+    # its completed samples say why; one under way for longer than 3 periods + the timeout: unknown, and why
+    assert all("did not answer getPid" in h["why"] or h["why"].startswith("no answer from the node for ")
+               for h in hung), hung[:5]
+    assert sum(h["alive"] is False for h in hung) > len(hung) / 2, hung[:5]
     assert "Traceback" not in ros.log(proc)
 
 
