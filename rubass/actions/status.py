@@ -110,6 +110,9 @@ def build(spec: CheckedSpec, rules: Dict[str, Any], active: List[int], topics: D
     if monitor.get("silent agents", "none") not in ("none", ""):  # cpu/memory of that host's nodes unknown
         level = max(level, WARN)
         msg += f" (agent silent: {monitor['silent agents']})"
+    if monitor.get("agents claiming one host", "none") not in ("none", ""):  # whose values are used is unclear
+        level = max(level, WARN)
+        msg += f" ({monitor['agents claiming one host']})"
     if monitor.get("last reload error"):
         msg += " (the last reload was rejected; the previous rules still run)"
     if failing:

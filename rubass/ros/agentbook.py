@@ -290,8 +290,8 @@ class AgentBook:
                 for host, a in sorted(by_host.items()) if len(a) > 1]
 
     def silent(self, at: float) -> List[str]:
-        """What makes the monitor's status WARN: agents whose last report is stale, as 'AGENT on
-        HOST for N s', and hosts that two fresh agents claim (`conflicts`)."""
+        """Agents whose last report is stale, as 'AGENT on HOST for N s' (the monitor's status WARNs, as
+        it does for `conflicts`)."""
         heard = self._prune(at)
         fresh = {h.report.host: h.report.agent for h in heard if at < h.stale_at and h.report.host}
         out = []
@@ -300,7 +300,7 @@ class AgentBook:
                 other = fresh.get(h.report.host)
                 also = f" (host reported by {other} now)" if other else ""
                 out.append(f"{h.report.agent} on {h.report.host or '?'} for {at - h.at:.1f} s{also}")
-        return out + self.conflicts(at)
+        return out
 
     def summary(self, at: float) -> str:
         """One line for /diagnostics: every agent, its host, its nodes and its last report's age."""

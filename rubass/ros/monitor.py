@@ -404,6 +404,7 @@ class Monitor(Reloading):
             "reaction latency p50 ms": f"{lat[len(lat) // 2] * 1000:.3f}" if lat else "n/a",
             "agents": self.agents.summary(time.monotonic()),
             "silent agents": ", ".join(self.agents.silent(time.monotonic())) or "none",
+            "agents claiming one host": "; ".join(self.agents.conflicts(time.monotonic())) or "none",
         }
         for name, r in self.runners.items():
             if r.stats.last_error:
