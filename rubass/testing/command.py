@@ -40,10 +40,19 @@ def print_results(results: List[FileResult], out: TextIO, err: TextIO) -> None:
                 print(f"    {problem}", file=out)
 
 
+def summary(results: List[FileResult]) -> str:
+    """The last line, `N passed, N failed`, led by the files none of whose tests ran, so that a file with
+    errors never reads as a clean run: `not run: 3 errors in x.test.yaml; 0 passed, 0 failed`."""
+    passed = sum(o.passed for r in results for o in r.outcomes)
+    failed = sum(not o.passed for r in results for o in r.outcomes)
+    unrun = ", ".join(f"{n} error{'s' if n != 1 else ''} in {shown_path(r.path)}"
+                      for r, n in ((r, max(r.error_count, 1)) for r in results if r.error))
+    return f"{'not run: ' + unrun + '; ' if unrun else ''}{passed} passed, {failed} failed"
+
+
 def run(args: argparse.Namespace) -> int:
     results = [run_file(path, args.actions) for path in args.files]
     print_results(results, sys.stdout, sys.stderr)
-    passed = sum(o.passed for r in results for o in r.outcomes)
     failed = sum(not o.passed for r in results for o in r.outcomes)
     if args.coverage:
         by_spec: Dict[str, List[FileResult]] = {}
@@ -64,7 +73,7 @@ def run(args: argparse.Namespace) -> int:
             junit_error = f"rubass test: error: cannot write {args.junit}: {exc}"
         except OSError as exc:
             junit_error = f"rubass test: error: cannot write {args.junit}: {exc.strerror or exc}"
-    print(f"{passed} passed, {failed} failed")  # the last line, even when the XML could not be written
+    print(summary(results))  # the last line, even when the XML could not be written
     if junit_error:
         sys.stdout.flush()
         print(junit_error, file=sys.stderr)

@@ -28,14 +28,16 @@ class _Reader:
     def fail(self, line: int, message: str, fatal: bool = False) -> TestFileError:
         return TestFileError(self.path, line, message, fatal)
 
-    def guard(self, default: T, read: Callable[..., T], *args: Any) -> T:
+    def guard(self, default: T, read: Callable[..., T], *args: Any, also: bool = False) -> T:
         """read(*args), or `default` when it fails: its error is kept and reading goes on, so that
-        one run reports every error of the file (a fatal one still stops the file)."""
+        one run reports every error of the file (a fatal one still stops the file). `also`: the error
+        is said even after another one at its line (a negative `at` beside a misspelt key)."""
         try:
             return read(*args)
         except TestFileError as exc:
             if exc.fatal:
                 raise
+            exc.also = also
             self.errors.append(exc)
             return default
 
@@ -80,9 +82,12 @@ class _Reader:
     # -- the file ---------------------------------------------------------------------------
     def read(self) -> TestFile:
         doc = load(self.path)
-        top = self.mapping(doc, 1, "a test file", ("spec", "actions", "model", "tests"), ("spec", "tests"))
-        spec = top["spec"]
-        if not isinstance(spec, str) or not spec:
+        top = self.mapping(doc, 1, "a test file", ("spec", "actions", "model", "tests"))
+        for key in ("spec", "tests"):  # a missing one is said, and the rest of the file is still read
+            if key not in top:
+                self.errors.append(self.fail(top.line or 1, f"a test file needs '{key}'"))
+        spec = top.get("spec", "")
+        if "spec" in top and (not isinstance(spec, str) or not spec):
             self.errors.append(self.fail(top.at("spec"), "spec must be the path of a .rbs file"))
             spec = ""
         base = os.path.dirname(os.path.abspath(self.path))
@@ -90,8 +95,8 @@ class _Reader:
         model = self.guard(None, self.model, top, base) if "model" in top else None
         self.registry = model.registry if model is not None else None
         self.sysmodel = model
-        tests = self.guard(LList(), self.seq, top["tests"], top.at("tests"), "tests")
-        if not tests and isinstance(top["tests"], LList):
+        tests = self.guard(LList(), self.seq, top.get("tests", LList()), top.at("tests"), "tests")
+        if not tests and isinstance(top.get("tests"), LList):
             self.errors.append(self.fail(top.at("tests"), "tests is empty: a file needs at least one test"))
         cases = [c for c in (self.guard(None, self.case, t, tests.at(i), i) for i, t in enumerate(tests)) if c]
         seen: Dict[str, int] = {}
@@ -179,21 +184,28 @@ class _Reader:
         if not topic.startswith("/"):
             topic = "/" + topic
         t = self.mapping(value, line, f"topic {topic}", ("type", "rate", "start", "field", "fields", "values",
-                                                         "messages"), ("type",))
-        try:
-            cls = message_class(t["type"], self.registry)
-        except NoRosPython as exc:  # no type can be had here: said once, for the whole file
-            raise self.fail(t.at("type"), str(exc), fatal=True) from None
-        except MessageError as exc:
-            raise self.fail(t.at("type"), str(exc)) from None
+                                                         "messages"))
+        # without its type (missing, not installed), the rest of the topic is still read: all but what
+        # needs the type (its series' fields and their units) is checked
+        known = TopicInput(topic, str(t.get("type", "")), None, line)
+        if "type" not in t:
+            self.errors.append(self.fail(line, f"topic {topic} needs 'type'"))
+        else:
+            try:
+                known.cls = message_class(t["type"], self.registry)
+            except NoRosPython as exc:  # no type can be had here: said once, for the whole file
+                raise self.fail(t.at("type"), str(exc), fatal=True) from None
+            except MessageError as exc:
+                self.errors.append(self.fail(t.at("type"), str(exc)))
         before = case.topics.get(topic)
-        if before is not None and before.type_name != t["type"]:  # `odom:` beside `/odom:`: one topic
-            raise self.fail(t.at("type"), f"topic {topic} is {before.type_name} at line {before.line}: one topic "
-                                          f"has one type")
-        case.topics[topic] = TopicInput(topic, t["type"], cls, line)
+        if before is not None and known.cls is not None and before.type_name != t["type"]:  # `odom:` beside `/odom:`
+            self.errors.append(self.fail(t.at("type"), f"topic {topic} is {before.type_name} at line {before.line}: "
+                                                       f"one topic has one type"))
+        elif known.cls is not None:
+            case.topics[topic] = known
         series = [k for k in ("field", "fields", "values", "rate") if k in t]
         if series:
-            self.guard(None, self.series, case, topic, t)
+            self.guard(None, self.series, known, case, t)
         if "messages" in t:
             msgs = self.seq(t["messages"], t.at("messages"), f"messages of {topic}")
             for k, m in enumerate(msgs):
@@ -201,13 +213,12 @@ class _Reader:
         if not series and "messages" not in t:
             raise self.fail(line, f"topic {topic} has no input: give a series (rate, field, values) or messages")
 
-    def series(self, case: Case, topic: str, t: LDict) -> None:
-        if "rate" not in t:
-            raise self.fail(t.line, f"the series of {topic} needs a rate (e.g. rate: 10 Hz)")
-        rate = self.quantity(t["rate"], t.at("rate"), "rate", FREQUENCY, "Hz")
-        if rate <= 0:
-            raise self.fail(t.at("rate"), "rate must be more than 0 Hz")
-        start = self.time(t.get("start", 0.0), t.at("start"), "start")
+    def series(self, known: TopicInput, case: Case, t: LDict) -> None:
+        """A series of `known` (its cls None when its type cannot be had: then its fields and their units
+        are left unchecked); each error at its line, the rest still read (a bad rate, field or value)."""
+        topic, before = known.topic, len(self.errors)
+        rate = self.guard(None, self.rate, topic, t)
+        start = self.guard(0.0, self.time, t.get("start", 0.0), t.at("start"), "start")
         if ("field" in t) == ("fields" in t):
             raise self.fail(t.line, f"the series of {topic} needs either field + values or fields")
         if "field" in t:
@@ -225,20 +236,28 @@ class _Reader:
         lines: List[int] = []
         for path_text, values, pline, vline in columns:
             try:
-                path = parse_path(path_text)
+                path: Path = parse_path(path_text)
+                field_dim = self.field_dim(known, path, pline) if known.cls is not None else UNKNOWN
             except MessageError as exc:
-                raise self.fail(pline, str(exc)) from None
-            field_dim = self.field_dim(case.topics[topic], path, pline)
+                self.errors.append(self.fail(pline, str(exc)))
+                path, field_dim = (), UNKNOWN  # its values are still read, their units unchecked
+            except TestFileError as exc:
+                self.errors.append(exc)
+                field_dim = UNKNOWN
             try:
                 steps.append((path, expand(values, field_dim, str(path_text))))
             except SeriesError as exc:
-                raise self.fail(vline, f"values of {path_text}: {exc}") from None
+                self.errors.append(self.fail(vline, f"values of {path_text}: {exc}"))
             lines.append(vline)
+        if len(steps) != len(columns) or rate is None:
+            return  # what is left needs every column's steps and the rate
         lengths = {len(s) for _, s in steps}
         if len(lengths) != 1:
             raise self.fail(t.at("fields"), f"the fields of {topic} have series of different lengths "
                                             f"({', '.join(str(len(s)) for _, s in steps)} steps)")
         n = lengths.pop()
+        if len(self.errors) > before or known.cls is None:
+            return  # the steps are checked; no message is built of a series with an error
         if len(case.messages) + n > MAX_MESSAGES:
             raise self.fail(t.line, f"more than {MAX_MESSAGES} messages in one test")
         for k in range(n):
@@ -252,6 +271,14 @@ class _Reader:
             if parts:
                 line = t.at("values") if "values" in t else t.at("fields")
                 case.messages.append(MessageInput(round(start + k / rate, 9), topic, parts, line))
+
+    def rate(self, topic: str, t: LDict) -> float:
+        if "rate" not in t:
+            raise self.fail(t.line, f"the series of {topic} needs a rate (e.g. rate: 10 Hz)")
+        rate = self.quantity(t["rate"], t.at("rate"), "rate", FREQUENCY, "Hz")
+        if rate <= 0:
+            raise self.fail(t.at("rate"), "rate must be more than 0 Hz")
+        return rate
 
     def field_dim(self, t: TopicInput, path: Path, line: int) -> Any:
         """The dimension of a series' field (series.UNKNOWN when no unit table gives it, None when it is
@@ -306,6 +333,9 @@ class _Reader:
     def expect(self, value: Any, line: int) -> Expect:
         e = self.mapping(value, line, "an expectation", ("at", "start", "release", "never", "active", "from", "to",
                                                          "tolerance"))
+        # its times first: a bad one is said beside a misspelt key of the same line (`{at: -1 s, strat: x}`)
+        times = {k: self.guard(None, self.time, e[k], e.at(k), k, also=True) for k in ("at", "from", "to", "tolerance")
+                 if k in e}
         kinds = [k for k in ("start", "release", "never", "active") if k in e]
         if len(kinds) != 1:
             raise self.fail(line, "an expectation has one of start, release, never or active")
@@ -313,9 +343,8 @@ class _Reader:
         name = e[kind]
         if isinstance(name, bool) or not isinstance(name, (str, int)) or name == "":
             raise self.fail(e.at(kind), f"{kind} names a behaviour (name or number) or an action")
-        out = Expect(kind, name, line)
-        if "tolerance" in e:
-            out.tolerance = self.time(e["tolerance"], e.at("tolerance"), "tolerance")
+        out = Expect(kind, name, line)  # with a bad time it is kept (its name is still checked), at 0 s
+        out.tolerance = times.get("tolerance")
         allowed = {"start": ("at",), "release": ("at",), "never": (), "active": ("from", "to")}[kind]
         for k in ("at", "from", "to"):
             if k in e and k not in allowed:
@@ -323,11 +352,10 @@ class _Reader:
             if k not in e and k in allowed:
                 raise self.fail(line, f"{kind} needs '{k}'")
         if kind in ("start", "release"):
-            out.at = self.time(e["at"], e.at("at"), "at")
+            out.at = times["at"] or 0.0
         elif kind == "active":
-            out.start = self.time(e["from"], e.at("from"), "from")
-            out.end = self.time(e["to"], e.at("to"), "to")
-            if out.end < out.start:
+            out.start, out.end = times["from"] or 0.0, times["to"] or 0.0
+            if times["from"] is not None and times["to"] is not None and out.end < out.start:
                 raise self.fail(e.at("to"), "to is before from")
         return out
 

@@ -24,6 +24,7 @@ class FileResult:
     spec: Optional[CheckedSpec] = None
     outcomes: List[Outcome] = field(default_factory=list)
     error: str = ""  # `FILE:LINE: error: …` when the file could not run
+    error_count: int = 0  # how many errors `error` says (a spec's own errors count as the one at `spec:`)
     warnings: List[str] = field(default_factory=list)
 
 
@@ -45,13 +46,16 @@ def run_file(path: str, extra_actions: Sequence[str] = ()) -> FileResult:
                     prepared.append(p)
             result.warnings += _unknown_covers(spec, tf, path)
         if errors:
-            result.error = "\n".join(_rendered(errors))
+            rendered = _rendered(errors)
+            result.error, result.error_count = "\n".join(rendered), len(rendered)
             return result
     except TestFileError as exc:  # the file cannot be read at all
-        result.error = "\n".join(_rendered(exc.before + [exc]))
+        rendered = _rendered(exc.before + [exc])
+        result.error, result.error_count = "\n".join(rendered), len(rendered)
         return result
     except Exception as exc:  # a bug must not hide the other files' results behind a traceback
         result.error = f"{path}: error: internal error while reading the tests: {type(exc).__name__}: {exc}"
+        result.error_count = 1
         return result
     for p in prepared:
         t0 = time.perf_counter()
@@ -67,11 +71,14 @@ def run_file(path: str, extra_actions: Sequence[str] = ()) -> FileResult:
 
 def _rendered(errors: List[TestFileError]) -> List[str]:
     """The first error of each line, in line order (a second one at a line mostly follows from the first:
-    `{at: 2 s, strat: x}` lacks a start because of its typo)."""
-    out: Dict[int, str] = {}
+    `{at: 2 s, strat: x}` lacks a start because of its typo), and those that cannot follow from it (`also`:
+    a negative `at` beside that typo)."""
+    out: Dict[int, List[str]] = {}
     for e in sorted(errors, key=lambda e: e.line):
-        out.setdefault(e.line, e.render())
-    return list(out.values())
+        said = out.setdefault(e.line, [])
+        if not said or (e.also and e.render() not in said):
+            said.append(e.render())
+    return [text for line in sorted(out) for text in out[line]]
 
 
 def _load_spec(tf: TestFile, actions: List[str], errors: List[TestFileError]) -> Optional[CheckedSpec]:

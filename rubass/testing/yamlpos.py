@@ -16,6 +16,7 @@ class TestFileError(RubassError):
         self.path, self.line, self.message = path, line, message
         self.fatal = fatal  # nothing more of the file can be read or checked
         self.before: List["TestFileError"] = []  # errors found before this one stopped the reading
+        self.also = False  # said even after another error at its line (it cannot follow from that one)
 
     def render(self) -> str:
         return f"{self.path}:{self.line}: error: {self.message}" if self.line else f"{self.path}: error: {self.message}"
