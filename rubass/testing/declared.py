@@ -2,14 +2,15 @@
 units), besides the `model:` it names, so the spec is checked as `rubass check --bag` checks it."""
 from __future__ import annotations
 
+import dataclasses
 import os
-from typing import Any, Dict, Optional, Set, Tuple
+from typing import Any, Dict, List, Optional, Set, Tuple
 
 from ..lang.ast import PathElem
 from ..lang.fieldmodel import FieldInfo
 from ..lang.msgdef import DefinitionError, Registry
 from ..lang.sysmodel import SystemModel, norm_topic
-from .cases import TestFile
+from .cases import Case, TestFile
 
 
 class DeclaredModel:
@@ -50,10 +51,9 @@ def _add_class(registry: Registry, cls: Any) -> None:
         pass
 
 
-def declared_model(tf: TestFile) -> Optional[DeclaredModel]:
-    """The model to check the spec of `tf` against: its `model:` (types it does not define filled from
-    the installed ones, as `rubass check --model` does) plus every topic a test declares with a type the
-    model lacks; a topic two tests give two types is left unknown. None when there is nothing to know."""
+def _types(tf: TestFile) -> Tuple[Dict[str, Any], Set[str]]:
+    """The message class the tests give each topic (the first one's), and the topics two tests type
+    differently."""
     types: Dict[str, Any] = {}
     twice: Set[str] = set()
     for case in tf.cases:
@@ -62,6 +62,20 @@ def declared_model(tf: TestFile) -> Optional[DeclaredModel]:
             if name in types and types[name]._type != t.cls._type:
                 twice.add(name)
             types.setdefault(name, t.cls)
+    return types, twice
+
+
+def declared_model(tf: TestFile, case: Optional[Case] = None) -> Optional[DeclaredModel]:
+    """The model to check the spec of `tf` against: its `model:` (types it does not define filled from
+    the installed ones, as `rubass check --model` does) plus every topic a test declares with a type the
+    model lacks; a topic two tests give two types is left unknown, or, with `case`, has the type that
+    test gives it. None when there is nothing to know. The file's own model is not changed."""
+    types, twice = _types(tf)
+    if case is not None:
+        for topic, t in case.topics.items():
+            if norm_topic(topic) in twice:
+                types[norm_topic(topic)] = t.cls
+        twice = twice - {norm_topic(topic) for topic in case.topics}
     model = tf.model
     if model is None:
         if not types:
@@ -70,6 +84,7 @@ def declared_model(tf: TestFile) -> Optional[DeclaredModel]:
     else:
         from ..ros.libtypes import try_installed
 
+        model = dataclasses.replace(model, topics=dict(model.topics))  # the declared types are this one's
         undefined = model.undefined_types()
         if undefined:
             try_installed(model.registry, undefined, ())
@@ -81,3 +96,20 @@ def declared_model(tf: TestFile) -> Optional[DeclaredModel]:
         _add_class(model.registry, cls)
         declared[name] = cls
     return DeclaredModel(model, declared)
+
+
+def per_test_models(tf: TestFile) -> List[Tuple[Case, DeclaredModel]]:
+    """For a file whose tests give one topic different types: each distinct combination of the types its
+    tests give those topics, with the first test that gives it, and the model of that test's types (the
+    spec is checked against each, as each test's messages are what the spec reads in it)."""
+    _, twice = _types(tf)
+    seen: Set[Tuple[Tuple[str, str], ...]] = set()
+    out = []
+    for case in tf.cases:
+        key = tuple(sorted((norm_topic(n), t.cls._type) for n, t in case.topics.items() if norm_topic(n) in twice))
+        if key and key not in seen:
+            seen.add(key)
+            model = declared_model(tf, case)
+            if model is not None:
+                out.append((case, model))
+    return out

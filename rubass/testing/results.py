@@ -4,13 +4,13 @@ from __future__ import annotations
 import os
 import time
 from dataclasses import dataclass, field
-from typing import Dict, List, Optional, Sequence
+from typing import Dict, List, Optional, Sequence, Set
 
 from ..lang import SpecError, load_spec
 from ..lang.errors import did_you_mean
 from ..lang.model import CheckedSpec
 from .coverage import traced, unknown_covers
-from .declared import declared_model
+from .declared import declared_model, per_test_models
 from .cases import TestFile
 from .format import read_test_file
 from .runner import Outcome, execute, prepare_all
@@ -85,22 +85,30 @@ def _load_spec(tf: TestFile, actions: List[str], errors: List[TestFileError]) ->
     """The spec to run (checked against the file's `model:` when it names one), then checked against the
     types the file's topics declare, with their standard units, as `rubass replay` checks it against a
     recording's (the spec that runs is the one the monitor would run); its errors as one error at the
-    `spec:` line."""
+    `spec:` line. A topic two tests type differently is checked with each test's own types: each error
+    once, naming the first test whose types show it."""
     model = declared_model(tf)
     try:
         spec = load_spec(tf.spec, actions, model=model if tf.model is not None else None)
-        if model is not None and tf.model is None:
-            try:
-                load_spec(tf.spec, actions, model=model)
-            except SpecError as exc:
-                why = "does not fit the types of the topics this file declares (as `rubass check --bag` says of a " \
-                      "recording of them)"
-                errors.append(TestFileError(tf.path, tf.spec_line, _spec_error(tf.spec, why, exc)))
-                return None
-        return spec
     except SpecError as exc:
         errors.append(TestFileError(tf.path, tf.spec_line, _spec_error(tf.spec, "cannot be used", exc)))
         return None
+    said: Set[str] = set()
+    checks = [("this file declares", model)] if model is not None and tf.model is None else []
+    checks += [(f"test '{case.name}' (line {case.line}) declares", m) for case, m in per_test_models(tf)]
+    for whose, m in checks:
+        try:
+            load_spec(tf.spec, actions, model=m)
+        except SpecError as exc:
+            new = [d for d in exc.diagnostics if d.render(exc.sources) not in said]
+            said.update(d.render(exc.sources) for d in new)
+            if new:
+                why = f"does not fit the types of the topics {whose} (as `rubass check --bag` says of a recording " \
+                      f"of them)"
+                err = TestFileError(tf.path, tf.spec_line, _spec_error(tf.spec, why, SpecError(new, exc.sources)))
+                err.also = True  # each test's errors are its own
+                errors.append(err)
+    return spec  # with errors, the file does not run; its tests are still checked against the spec
 
 
 def _spec_error(path: str, why: str, exc: SpecError) -> str:
