@@ -127,10 +127,11 @@ class Agent:
         self._save_cache()
         return len(kept)
 
-    def discover(self) -> None:
+    def discover(self, stop: Optional[threading.Event] = None) -> None:
         """Add the registered nodes whose URI is on this host; forget those the master does not know
         that no longer answer getName with their name at their URI (the master keeps a killed node's
-        registrations; a restarted master knows only the nodes started since)."""
+        registrations; a restarted master knows only the nodes started since). `stop` set: no
+        further question to a master that may have stopped answering half-way."""
         master = rpc.proxy(self.master_uri, 1.0)
         try:
             code, msg, state = master.getSystemState(self.name)
@@ -141,6 +142,8 @@ class Agent:
             return
         names: Set[str] = {n for kind in state for _, nodes in kind for n in nodes}
         for name in sorted(names):
+            if stop is not None and stop.is_set():
+                return
             try:
                 code, _, uri = master.lookupNode(self.name, name)
             except (OSError, xmlrpc.client.Error):
@@ -180,7 +183,7 @@ class Agent:
         """discover() every `period` seconds until `stop` is set (on a thread of its own)."""
         while not stop.wait(period):
             try:
-                self.discover()
+                self.discover(stop)
             except Exception as exc:  # never let discovery die: log and try again
                 self.log("error", f"rubass agent: discovery failed: {exc.__class__.__name__}: {exc}")
 
@@ -259,15 +262,15 @@ LEAVING_FLUSH = 0.2  # s: for the leaving report to leave the publisher's queue 
 EXIT_GRACE = 3.0  # s: the leaving report, the master watch's stop and rospy's shutdown, then the process exits
 
 
-def exit_within(seconds: float) -> None:
-    """Exit 0 after `seconds` whatever is still running: rospy's shutdown unregisters from the
-    master without a timeout, and a master that does not answer would hold the agent for good."""
+def exit_within(seconds: float, code: int = 0) -> None:
+    """Exit with `code` after `seconds` whatever is still running: rospy's shutdown unregisters from
+    the master without a timeout, and a master that does not answer would hold the agent for good."""
     def cut() -> None:
         time.sleep(seconds)
         sys.stderr.write(f"[rubass agent] rospy did not shut down within {seconds:g} s (unregistering waits for the "
                          f"master): exiting; the agent had already stopped reporting\n")
         sys.stderr.flush()
-        os._exit(0)
+        os._exit(code)
 
     threading.Thread(target=cut, name="rubass-exit", daemon=True).start()
 
@@ -301,9 +304,9 @@ def main(argv: Optional[List[str]] = None) -> int:
         discover_period = 1.0 / read_rate(get, "discover_rate", 1.0, 0.01, 100.0)
     except ParamError as exc:
         code = _refuse(str(exc), stop)
+        exit_within(EXIT_GRACE, code)
     else:
         code = _run(rate, discover_period, stop)
-    exit_within(EXIT_GRACE)
     rospy.signal_shutdown("rubass agent stopped")  # unregisters: may wait for the master, cut above
     return code
 
@@ -361,7 +364,7 @@ def _run(rate: float, discover_period: float, stop: threading.Event) -> int:
     rospy.loginfo("rubass agent %s: reporting the nodes on host %s (%s) at %g Hz on %s", rospy.get_name(), host,
                   ", ".join(agent.addresses) or "no address", rate, AGENT_TOPIC)
     agent.load_cache()
-    agent.discover()
+    agent.discover(stop)
     threading.Thread(target=agent.discover_every, args=(discover_period, stop), name="rubass-discover",
                      daemon=True).start()  # a slow or hung master must not delay the reports
     next_at = time.monotonic()
@@ -378,6 +381,7 @@ def _run(rate: float, discover_period: float, stop: threading.Event) -> int:
         if delay < 0:
             next_at = time.monotonic()
         stop.wait(max(0.0, delay))
+    exit_within(EXIT_GRACE)  # from now: the watch's stop and rospy's unregistering may wait for the master
     leave()
     agent.close()
     return 0

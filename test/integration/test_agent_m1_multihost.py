@@ -57,3 +57,22 @@ def test_a_hung_node_leaves_the_other_nodes_of_its_host_known_to_the_monitor(clu
     # (a few may be on a loaded machine: 50 Hz leaves the agent 60 ms; with each report waiting for the
     # hung node's 100 ms getPid, about 40 % were)
     assert len(hog) > 50 and len(unknown) <= 0.05 * len(hog), (len(unknown), len(hog), cluster.logs())
+
+
+def test_sigterm_stops_an_agent_whose_host_is_cut_off_from_the_master(cluster):  # noqa: F811
+    """The tester's second case: with the link cut, the agent ignored SIGTERM until the link came back."""
+    agent = cluster.spawn("arm", [PY, os.path.join(ROOT, "scripts", "agent"), "_node_rate:=10"], "agent-arm")
+    wait_for(cluster, "the agent reporting", lambda: "reporting the nodes" in cluster.log(agent))
+    time.sleep(1.0)
+    cluster.net.cut("arm")
+    wait_for(cluster, "the agent notices the master is unreachable", lambda: "cannot be reached" in cluster.log(agent))
+    sent = time.time()
+    os.kill(agent.pid, signal.SIGTERM)
+    try:
+        code = agent.wait(20)
+    except Exception:
+        code = None
+    took = time.time() - sent
+    log = cluster.log(agent)
+    assert code == 0 and took < 8.0, (code, took, log)
+    assert "did not know this node" not in log and "Traceback" not in log, log
