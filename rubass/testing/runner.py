@@ -254,6 +254,7 @@ def prepare_all(spec: CheckedSpec, case: Case, path: str, warnings: List[str],
         try:
             targets.append((e, resolver.resolve(e.name, path, e.line)))
         except TestFileError as exc:
+            exc.also = True  # a name the spec lacks follows from nothing else at its line (`{at: -1 s, start: stpo}`)
             errors.append(exc)
     if not case.readable:
         return None

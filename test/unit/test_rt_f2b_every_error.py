@@ -143,3 +143,12 @@ tests:
     code, out, err = run(capsys, good, bad)
     n = len(errors(err))
     assert code == 2 and out.rstrip().splitlines()[-1] == f"not run: {n} errors in {bad}; 1 passed, 0 failed", out
+
+
+def test_a_bad_time_and_an_unknown_name_of_one_expectation_are_both_said(files, write, capsys):
+    files()
+    path = write("n.test.yaml", "spec: t.rbs\ntests:\n  - name: a\n    expect:\n      - {at: -1 s, start: stpo}\n")
+    code, out, err = run(capsys, path)
+    assert code == 2 and errors(err) == [
+        "5: at must not be negative",
+        "5: 'stpo' is neither a behaviour's name nor a declared action; did you mean 'stop'?"], err
