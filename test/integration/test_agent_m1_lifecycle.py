@@ -183,3 +183,41 @@ def test_a_restarted_agent_still_knows_the_nodes_after_a_master_restart(ros):
     assert found[-1]["seq"] < 30  # from its start, not after a minute
     assert "/gone" not in json.load(open(cache))["nodes"]
     assert "nodes known from" in ros.log(second) and "/kept" in ros.log(second), ros.log(second)
+
+
+def test_the_monitor_forgets_an_agent_that_left_rather_than_report_it_silent(ros):
+    """The relaunch case: agent.launch names each run anew; the old run's clean exit must not leave
+    a SILENT agent in the monitor's status for good."""
+    from rosharness import spec
+
+    path = spec(ros.tmp, "entity e: calm { rules: busy: cpu(node calm) > 95 %; }\n")
+    out = ros.tmp / "diag.jsonl"
+    out.touch()
+    node(ros, "calm", "talk", "/a", "5")
+    node(ros, "diag", "listen", str(out), "/diagnostics:diagnostic_msgs/DiagnosticArray")
+    ros.monitor(path, diagnostics_rate=5)
+    old = agent(ros, "agent-old", "__name:=rubass_agent_old", "_node_rate:=10")
+
+    def monitor_status():
+        found = []
+        for line in open(out).read().splitlines():
+            try:
+                rec = json.loads(line)
+            except ValueError:
+                continue
+            for st in rec["msg"]["status"]:
+                if st["name"] == "rubass: monitor":
+                    found.append((rec["wall"], st["message"], {kv["key"]: kv["value"] for kv in st["values"]}))
+        return found
+
+    wait_for("the monitor hears the agent", lambda: [s for s in monitor_status() if "/rubass_agent_old" in s[2].get(
+        "agents", "") and "SILENT" not in s[2]["agents"]], [old], ros)
+    old.send_signal(signal.SIGINT)
+    assert old.wait(15) == 0, ros.log(old)
+    stopped = time.time()
+    new = agent(ros, "agent-new", "__name:=rubass_agent_new", "_node_rate:=10")
+    wait_for("the new agent heard", lambda: [s for s in monitor_status() if s[0] > stopped and "/rubass_agent_new"
+                                             in s[2].get("agents", "")], [new], ros)
+    time.sleep(2.0)
+    later = [s for s in monitor_status() if s[0] > stopped + 1.0]
+    assert later and all("agent silent" not in s[1] and "SILENT" not in s[2].get("agents", "") for s in later), later[-1]
