@@ -41,13 +41,14 @@ def print_results(results: List[FileResult], out: TextIO, err: TextIO) -> None:
 
 
 def summary(results: List[FileResult]) -> str:
-    """The last line, `N passed, N failed`, led by the files none of whose tests ran, so that a file with
-    errors never reads as a clean run: `not run: 3 errors in x.test.yaml; 0 passed, 0 failed`."""
+    """The last line, `N passed, N failed` (TESTING.md), after a line naming the files none of whose tests
+    ran, so that a file with errors never reads as a clean run: `not run: 3 errors in x.test.yaml`."""
     passed = sum(o.passed for r in results for o in r.outcomes)
     failed = sum(not o.passed for r in results for o in r.outcomes)
     unrun = ", ".join(f"{n} error{'s' if n != 1 else ''} in {shown_path(r.path)}"
                       for r, n in ((r, max(r.error_count, 1)) for r in results if r.error))
-    return f"{'not run: ' + unrun + '; ' if unrun else ''}{passed} passed, {failed} failed"
+    head = f"not run: {unrun}\n" if unrun else ""
+    return f"{head}{passed} passed, {failed} failed"
 
 
 def run(args: argparse.Namespace) -> int:

@@ -60,7 +60,7 @@ def test_a_unit_error_the_declared_types_show_is_an_error_at_the_spec_line(spec,
     col = open(rbs).read().splitlines()[4].index("> 3 s") + 1
     assert f"{path}:1: error: spec {rbs} does not fit the types of the topics this file declares" in err, err
     assert f"{rbs}:5:{col}: error: compares a speed with a time" in err, err
-    assert "PASS" not in out and out.rstrip().endswith(f"not run: 1 error in {path}; 0 passed, 0 failed")
+    assert "PASS" not in out and out.rstrip().endswith(f"not run: 1 error in {path}\n0 passed, 0 failed")
 
 
 def test_the_right_unit_still_passes(spec, write, capsys):
@@ -123,7 +123,7 @@ def test_every_error_of_a_file_in_line_order(spec, write, capsys):
         f"{path}:11: error: 'cautoin' is neither a behaviour's name nor a declared action; did you mean 'caution'?",
         f"{path}:12: error: unknown key 'strat' in an expectation; did you mean 'start'? (keys: at, start, release, "
         f"never, active, from, to, tolerance)"], err
-    assert out.rstrip().endswith(f"not run: 2 errors in {path}; 0 passed, 0 failed")
+    assert out.rstrip().endswith(f"not run: 2 errors in {path}\n0 passed, 0 failed")
 
 
 def test_errors_of_several_tests_keys_and_messages_all_come(spec, write, capsys):
