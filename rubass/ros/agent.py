@@ -44,6 +44,7 @@ from . import agent_cache, rpc
 from .agentbook import AGENT_TOPIC, STALE_PERIODS, encode, is_loopback, node_entry
 from .nodes import NodeSampler, NodeStatus
 from .params import ParamError, read_rate, unknown_params
+from .exiting import exit_within
 from .startup import init_node, wants_help
 
 Log = Callable[[str, str], None]
@@ -260,19 +261,7 @@ UNREACHABLE = ("the nodes of this host keep being reported to the monitors alrea
 BAD_PARAM_REPEAT = 60.0  # s: how often an agent that cannot start says so again
 LEAVING_FLUSH = 0.2  # s: for the leaving report to leave the publisher's queue before rospy closes connections
 EXIT_GRACE = 3.0  # s: the leaving report, the master watch's stop and rospy's shutdown, then the process exits
-
-
-def exit_within(seconds: float, code: int = 0) -> None:
-    """Exit with `code` after `seconds` whatever is still running: rospy's shutdown unregisters from
-    the master without a timeout, and a master that does not answer would hold the agent for good."""
-    def cut() -> None:
-        time.sleep(seconds)
-        sys.stderr.write(f"[rubass agent] rospy did not shut down within {seconds:g} s (unregistering waits for the "
-                         f"master): exiting; the agent had already stopped reporting\n")
-        sys.stderr.flush()
-        os._exit(code)
-
-    threading.Thread(target=cut, name="rubass-exit", daemon=True).start()
+AGENT_DONE = "the agent had already stopped reporting"  # what exit_within says had been done
 
 
 def main(argv: Optional[List[str]] = None) -> int:
@@ -304,7 +293,7 @@ def main(argv: Optional[List[str]] = None) -> int:
         discover_period = 1.0 / read_rate(get, "discover_rate", 1.0, 0.01, 100.0)
     except ParamError as exc:
         code = _refuse(str(exc), stop)
-        exit_within(EXIT_GRACE, code)
+        exit_within(EXIT_GRACE, code, AGENT_DONE)
     else:
         code = _run(rate, discover_period, stop)
     rospy.signal_shutdown("rubass agent stopped")  # unregisters: may wait for the master, cut above
@@ -381,7 +370,7 @@ def _run(rate: float, discover_period: float, stop: threading.Event) -> int:
         if delay < 0:
             next_at = time.monotonic()
         stop.wait(max(0.0, delay))
-    exit_within(EXIT_GRACE)  # from now: the watch's stop and rospy's unregistering may wait for the master
+    exit_within(EXIT_GRACE, 0, AGENT_DONE)  # from now: the watch's stop and rospy's unregistering may wait for the master
     leave()
     agent.close()
     return 0
