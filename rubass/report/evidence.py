@@ -18,7 +18,6 @@ from ..testing.coverage import Coverage, coverage
 from ..testing.results import FileResult
 from ..testing.runner import Outcome
 from .bench import Reaction
-from .design import design_chain  # noqa: F401  (re-exported: the reaction by design lives in design.py)
 
 
 class ReportError(RubassError):
