@@ -11,7 +11,7 @@ from .modelcheck import definition_problems, duplicates, unit_path_problem, vers
 from .msgdef import TYPE_RE, DefinitionError, parse_msg
 from .source import Source, SourceSet, Span
 from .sysmodel import SystemModel
-from .units import DIMENSIONLESS, UNITS, Dimension
+from .units import DIMENSIONLESS, UNITS, Dimension, unit_suggestion
 from .yamltags import PLAIN_TAGS, foreign_tags, plain_value
 
 KEYS = ("rubass_model", "source", "topics", "nodes", "units", "definitions")
@@ -69,8 +69,9 @@ class _Reader:
                 continue
             if unit not in UNITS or UNITS[unit][0] != 1.0:
                 si = [u for u, (f, _) in UNITS.items() if f == 1.0] + ["1"]
+                hint = unit_suggestion(unit) if unit not in UNITS else ""  # 'km/h' is known, just not SI
                 self.error(vnode, f"'{unit}' is not an SI unit rubass knows (ROS messages are SI): one of "
-                                  f"{', '.join(si)}{did_you_mean(unit, si)}")
+                                  f"{', '.join(si)}{hint}")
                 continue
             out[path] = UNITS[unit][1]
         return out

@@ -299,6 +299,8 @@ class ExprChecker(BuiltinChecks):
                                             "or the square root of a negative)")
             else:
                 self.error(e.duration.span, f"the duration of '{word}' must be a constant time, such as '0.4 s'")
+        elif dty.kind == "any":
+            pass  # an unknown unit, said where it is written: not a second error for the same mistake
         elif dty.bare:
             self.error(e.duration.span, f"the duration of '{word}' needs a unit of time: write "
                                         f"'{_num_text(duration.value)} s'")

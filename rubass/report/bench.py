@@ -10,6 +10,7 @@ from dataclasses import dataclass
 from typing import List, Optional
 
 from ..lang.errors import RubassError
+from .design import up
 
 README = os.path.join(os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))),
                       "bench", "README.md")
@@ -31,8 +32,8 @@ class Reaction:
         """The figures as what they are: one case's, or the largest of each over several cases (the p50
         shown is then no median of anything: the slowest case's)."""
         if self.cases == 1:
-            return f"p50 {self.p50_ms:g} ms, p99 {self.p99_ms:g} ms, worst {self.worst_ms:g} ms"
-        return (f"largest p50 {self.p50_ms:g} ms, largest p99 {self.p99_ms:g} ms and worst {self.worst_ms:g} ms "
+            return f"p50 {up(self.p50_ms)} ms, p99 {up(self.p99_ms)} ms, worst {up(self.worst_ms)} ms"
+        return (f"largest p50 {up(self.p50_ms)} ms, largest p99 {up(self.p99_ms)} ms and worst {up(self.worst_ms)} ms "
                 f"over {self.cases} cases")
 
     def p99_label(self) -> str:
@@ -78,10 +79,13 @@ def from_json_lines(path: str) -> Reaction:
         except ValueError:
             first_bad = first_bad or f"line {number} is not JSON"
             continue
-        rb = obj.get("rubass") if isinstance(obj, dict) and obj.get("benchmark") == "reaction" else None
-        if not isinstance(rb, dict):
+        if not (isinstance(obj, dict) and obj.get("benchmark") == "reaction"):
             first_bad = first_bad or f"line {number} holds no reaction figures"
             continue
+        rb = obj.get("rubass")
+        if not isinstance(rb, dict):  # a reaction case without figures bounds nothing: not skipped
+            raise BenchError(f"{path}:{number}: a reaction case without its figures (\"rubass\" is "
+                             f"{json.dumps(rb)}): no upper bound; measure again")
         why = _no_bound(obj, rb)  # a case whose stops did not all come, or not one each, bounds nothing
         if why:
             case = f"{obj.get('rate_hz', '?')} Hz{', loaded' if obj.get('background_load') else ''}"
@@ -92,9 +96,9 @@ def from_json_lines(path: str) -> Reaction:
         except (KeyError, TypeError, ValueError):
             raise BenchError(f"{path}:{number}: a reaction needs the numbers max_ms, p99_ms and p50_ms "
                              f"under \"rubass\"") from None
-        if not all(math.isfinite(f) for f in figures):
-            raise BenchError(f"{path}:{number}: a reaction figure is not a finite number: no upper bound; "
-                             f"measure again")
+        if not all(math.isfinite(f) and f >= 0 for f in figures):
+            raise BenchError(f"{path}:{number}: a reaction figure is not a finite, non-negative number: no upper "
+                             f"bound; measure again")
         worst, p99, p50 = max(worst, figures[0]), max(p99, figures[1]), max(p50, figures[2])
         n += 1
     if not n:

@@ -61,6 +61,11 @@ def run(args: argparse.Namespace) -> int:
     ev = Evidence(spec, hazards, results, bags, reaction)
     build_matrix(ev)
     text = render(ev)
+    if os.path.isdir(args.output):
+        print(f"rubass report: error: {args.output} is a folder: give the page's file name (-o "
+              f"{os.path.join(args.output, os.path.splitext(os.path.basename(args.spec))[0] + '.html')})",
+              file=sys.stderr)
+        return 1
     folder = os.path.dirname(os.path.abspath(args.output))
     try:
         os.makedirs(folder, exist_ok=True)
@@ -85,7 +90,8 @@ def run(args: argparse.Namespace) -> int:
           f"{gaps} gap{'s' if gaps != 1 else ''} in the matrix"
           + (f" ({untraced} rule{' traces' if untraced == 1 else 's trace'} to no hazard)" if untraced else "")
           + (f"; {len(foreign)} test file{'s' if len(foreign) != 1 else ''} of another spec not counted" if foreign
-             else ""))
+             else "")
+          + (f"; not run: {', '.join(r.path for r in results if r.error)}" if any(r.error for r in results) else ""))
     if reaction is not None and reaction.developers:
         print(f"note: the monitor's reaction on the page is the developers' figures"
               f"{f' of {reaction.date}' if reaction.date else ''} (bench/README.md), not this machine's: run "

@@ -96,7 +96,7 @@ def _reaction_card(ev: Evidence) -> str:
         return "<b>n/a</b>no benchmark figures"
     where = (f"the developers' figures{f' of {_e(r.date)}' if r.date else ''} (bench/README.md), "
              f"<span class='fail'>not measured on this machine</span>" if r.developers else f"measured: {_e(r.source)}")
-    return f"<b>≤ {r.worst_ms:g} ms</b>monitor's worst case ({_e(r.p99_label())} {r.p99_ms:g} ms); {where}"
+    return f"<b>≤ {up(r.worst_ms)} ms</b>monitor's worst case ({_e(r.p99_label())} {up(r.p99_ms)} ms); {where}"
 
 
 def _matrix(ev: Evidence) -> str:
@@ -164,7 +164,7 @@ def _rules(ev: Evidence) -> str:
     worst = ev.reaction.worst_ms if ev.reaction else None
     for r in ev.spec.rules:
         d = design(ev.spec, ast.RuleRef(r.key))  # through the rules it uses
-        bound = _e(d.text()) + (f" + ≤ {worst:g} ms = ≤ {up(d.total + worst / 1000)} s"
+        bound = _e(d.text()) + (f" + ≤ {up(worst)} ms = ≤ {up(d.total + worst / 1000)} s"
                                 if worst is not None and not d.unknown else "")
         rows.append(f"<tr><td><code>{_e(r.key)}</code></td><td>{_rule_id(ev, r)}</td><td>{_attr(r, 'hazard')}</td>"
                     f"<td>{_attr(r, 'title')}</td><td>{_attr(r, 'ref')}</td><td>{bound}</td>"
@@ -182,7 +182,7 @@ def _behaviours(ev: Evidence) -> str:
         hz = _list(hazards) if hazards else ""
         hz += (" " if hz else "") + (f"<span class='muted'>via rules: {_list(via)}</span>" if via else "")
         d = design(ev.spec, b.cond, frozenset({b.index}))
-        bound = _e(d.text()) + (f" + ≤ {worst:g} ms" if worst is not None and not d.unknown else "")
+        bound = _e(d.text()) + (f" + ≤ {up(worst)} ms" if worst is not None and not d.unknown else "")
         rows.append(f"<tr><td>{b.index}</td><td><b>{_e(behaviour_label(ev.spec, b.index))}</b></td>"
                     f"<td>{_attr(b, 'id')}</td><td>{hz or _list([])}</td><td>{_attr(b, 'title')}</td>"
                     f"<td>{_list(a.name for a in b.actions)}</td><td>{bound}</td>"

@@ -29,7 +29,8 @@ def test_a_clean_case_is_its_own_bound(write):
     (dict(max=1.2, missed=50, extra=0), "has 50 violations that got no stop"),
     (dict(max=1.2, missed=0, extra=1), "has 1 extra stops"),
     (dict(max="null", missed=0, extra=0), "measured no reaction"),
-    (dict(max="NaN", missed=0, extra=0), "not a finite number"),
+    (dict(max="NaN", missed=0, extra=0), "not a finite, non-negative number"),
+    (dict(max=-2, missed=0, extra=0), "not a finite, non-negative number"),
 ])
 def test_a_case_that_bounds_nothing_is_an_error_not_skipped(write, bad, why):
     path = _bench(write, dict(max=1.2, missed=0, extra=0), bad)
@@ -82,3 +83,29 @@ def test_the_page_rounds_its_totals_up(write, tmp_path, capsys):
     assert "1000 s + ≤ 64.6 ms = ≤ 1000.07 s" in rows["e.long"], rows["e.long"]
     assert "0.333334 s + ≤ 64.6 ms = ≤ 0.397934 s" in rows["e.slow_age"], rows["e.slow_age"]
     assert "not computed" in rows["e.resumed"] and "latched" in rows["e.resumed"]
+
+
+def test_a_reaction_case_without_its_figures_is_an_error_not_skipped(write):
+    path = write("reaction.jsonl", CASE.format(max=7.25, missed=0, extra=0)
+                 + '{"benchmark": "reaction", "rate_hz": 1000, "rubass": null, "rubass_unanswered": 0}\n')
+    with pytest.raises(BenchError) as err:
+        from_json_lines(path)
+    assert f"{path}:2: a reaction case without its figures" in str(err.value)
+
+
+def test_the_monitors_figures_are_rounded_up_on_the_page(write, tmp_path, capsys):
+    write("lib.yaml", LIB)
+    path = write("s.rbs", SPEC)
+    out = str(tmp_path / "r.html")
+    main(["report", path, "--bench", _bench(write, dict(max=1234.564, missed=0, extra=0)), "-o", out])
+    capsys.readouterr()
+    html = open(out, encoding="utf-8").read()
+    assert "≤ 1234.57 ms" in html and "1234.56 ms" not in html
+
+
+def test_an_output_that_is_a_folder_says_so(write, tmp_path, capsys):
+    write("lib.yaml", LIB)
+    path = write("s.rbs", SPEC)
+    code = main(["report", path, "-o", str(tmp_path)])
+    err = capsys.readouterr().err
+    assert code == 1 and f"{tmp_path} is a folder: give the page's file name" in err and "Traceback" not in err

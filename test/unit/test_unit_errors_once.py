@@ -1,0 +1,24 @@
+"""An unknown unit is one error at its place (not a second one for the `for` it times), and a model
+file's unit typo gets a suggestion of its own dimension ('m/sec' -> 'm/s', not 'sec')."""
+import pytest
+
+from rubass.lang import SpecError, check_text
+from rubass.lang.modelfile import load_model
+from rubass.lang.source import SourceSet
+
+HEAD = 'action primitive stop;\n'
+
+
+def test_an_unknown_unit_of_a_for_is_one_error():
+    with pytest.raises(SpecError) as err:
+        check_text(HEAD + "entity e { rules: r: (topic /a.data > 1) for 500 msec; }\nif (e.r) then { stop; }\n")
+    messages = [d.message for d in err.value.diagnostics if d.severity == "error" and "action" not in d.message]
+    assert messages == ["unknown unit 'msec'; did you mean 'ms'?"], messages
+
+
+def test_a_model_files_unit_typo_gets_a_suggestion_of_its_dimension(write):
+    path = write("m.yaml", "rubass_model: 1\ntopics:\n  /bms: acme/Pack\ndefinitions:\n  acme/Pack: |\n"
+                           "    float64 pack_voltage\nunits:\n  acme/Pack: {pack_voltage: m/sec}\n")
+    model, diags = load_model(path, SourceSet())
+    text = "\n".join(d.message for d in diags)
+    assert model is None and "'m/sec' is not an SI unit" in text and "did you mean 'm/s'?" in text, text
