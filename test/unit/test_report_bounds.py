@@ -109,3 +109,12 @@ def test_an_output_that_is_a_folder_says_so(write, tmp_path, capsys):
     code = main(["report", path, "-o", str(tmp_path)])
     err = capsys.readouterr().err
     assert code == 1 and f"{tmp_path} is a folder: give the page's file name" in err and "Traceback" not in err
+
+
+def test_a_test_file_that_cannot_run_is_named_on_the_last_line(write, tmp_path, capsys):
+    write("lib.yaml", LIB)
+    path = write("s.rbs", SPEC)
+    broken = write("broken.test.yaml", "spec: s.rbs\ntests:\n  - name: x\n    topics: {}\n    expect: [{at: 1 s, strat: stop}]\n")
+    code = main(["report", path, "--tests", broken, "-o", str(tmp_path / "r.html")])
+    out = capsys.readouterr().out
+    assert code == 1 and out.rstrip().splitlines()[-1].endswith(f"; not run: {broken}"), out
