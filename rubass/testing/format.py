@@ -8,13 +8,14 @@ from typing import Any, Callable, Dict, List, Tuple, TypeVar
 from ..lang.errors import did_you_mean
 from ..lang.units import MEMORY, TIME, FREQUENCY, parse_quantity
 from .cases import UNSET, Case, Expect, MessageInput, NodeSampleInput, TestFile, TopicInput
-from .messages import MessageError, NoRosPython, Path, field_info, fields_of, message_class, parse_path
+from .messages import MessageError, NoRosPython, Path, field_info, field_problems, message_class, parse_path
 from .series import GAP, UNKNOWN, SeriesError, expand
 from .yamlpos import LDict, LList, TestFileError, load
 
 DEFAULT_TOLERANCE = 1e-3
 MAX_TIME = 24 * 3600.0  # a test simulates at most a day (ticks at 50 Hz: 4.3 million)
 MAX_MESSAGES = 1_000_000  # per test: each is a real message object
+_CHECK_EPOCH = 1000.0  # test time 0 when a message's header stamp is checked (any such time does)
 T = TypeVar("T")
 
 
@@ -209,7 +210,7 @@ class _Reader:
         if "messages" in t:
             msgs = self.seq(t["messages"], t.at("messages"), f"messages of {topic}")
             for k, m in enumerate(msgs):
-                self.guard(None, self.message, case, topic, m, msgs.at(k))
+                self.guard(None, self.message, case, known, m, msgs.at(k))
         if not series and "messages" not in t:
             raise self.fail(line, f"topic {topic} has no input: give a series (rate, field, values) or messages")
 
@@ -300,16 +301,35 @@ class _Reader:
             return None
         return info.dim if info.dim is not None else UNKNOWN
 
-    def message(self, case: Case, topic: str, value: Any, line: int) -> None:
+    def message(self, case: Case, known: TopicInput, value: Any, line: int) -> None:
+        """One explicit message; its fields and values are checked against the topic's type here (when
+        the type can be had), each error at its field's line, whatever else is wrong in the file."""
+        topic = known.topic
         if not isinstance(value, LDict) or "at" not in value:
             raise self.fail(line, f"a message of {topic} is a mapping with 'at' and its fields")
-        at = self.time(value["at"], value.at("at"), "at")
-        rest = {k: v for k, v in value.items() if k != "at"}
-        try:
-            parts = fields_of(rest)
-        except MessageError as exc:
-            raise self.fail(line, str(exc)) from None
-        case.messages.append(MessageInput(at, topic, parts, line))
+        before = len(self.errors)
+        at = self.guard(None, self.time, value["at"], value.at("at"), "at", also=True)
+        parts: List[Tuple[Path, Any]] = []
+        keys: List[Any] = []
+        for k, v in value.items():
+            if k == "at":
+                continue
+            try:
+                parts.append((parse_path(str(k)), v))
+                keys.append(k)
+            except MessageError as exc:
+                self._also(value.key_at(k), str(exc))
+        if known.cls is not None:
+            for k, why in field_problems(known.cls, parts, _CHECK_EPOCH):
+                self._also(value.key_at(keys[k]) if k >= 0 else line, f"{topic} ({known.type_name}): {why}")
+        if len(self.errors) == before and at is not None:
+            case.messages.append(MessageInput(at, topic, parts, line))
+
+    def _also(self, line: int, message: str) -> None:
+        """An error said even beside another at its line: one field's error never follows from another's."""
+        err = self.fail(line, message)
+        err.also = True
+        self.errors.append(err)
 
     def node(self, case: Case, node: str, value: Any, line: int) -> None:
         samples = self.seq(value, line, f"the samples of node {node}")

@@ -235,9 +235,46 @@ def build(cls: Any, assignments: List[Tuple[Path, Any]], stamp: Optional[float])
     return msg
 
 
-def fields_of(mapping: Dict[str, Any]) -> List[Tuple[Path, Any]]:
-    """The assignments of an explicit message's mapping (each top-level key one assignment)."""
-    return [(parse_path(str(k)), v) for k, v in mapping.items()]
+_STAMP = ("header", "stamp")
+
+
+def _absolute(stamp: Any, epoch: float) -> Any:
+    """A header stamp in test time as the engine's absolute time; 0 stays the zero stamp."""
+    if isinstance(stamp, (int, float)) and not isinstance(stamp, bool) and stamp != 0:
+        if stamp < 0:
+            raise MessageError(f"'header.stamp' is a time (test time in seconds): {stamp!r} is before the "
+                               f"test's start (0 s)")
+        return epoch + stamp
+    return stamp
+
+
+def in_test_time(fpath: Path, value: Any, epoch: float) -> Any:
+    """`value` to assign at `fpath`, with the message's header stamp in test time (test time 0 is `epoch`)
+    however it is written: `header.stamp: T` (a path, or a series of it) or `header: {stamp: T}`."""
+    if fpath == _STAMP:
+        return _absolute(value, epoch)
+    if fpath == _STAMP[:1] and isinstance(value, dict) and "stamp" in value:
+        return {**value, "stamp": _absolute(value["stamp"], epoch)}
+    return value
+
+
+def field_problems(cls: Any, assignments: List[Tuple[Path, Any]], epoch: float) -> List[Tuple[int, str]]:
+    """What is wrong in one message of `cls` (its fields as `assignments`, the stamp in test time): each
+    assignment's problem by its index (a field the type lacks, a value it does not allow), and then
+    (index -1) what only sending the whole message shows (an integer out of range). Empty: it fits."""
+    msg = cls()
+    out: List[Tuple[int, str]] = []
+    for k, (path, value) in enumerate(assignments):
+        try:
+            assign(msg, path, in_test_time(path, value, epoch))
+        except MessageError as exc:
+            out.append((k, str(exc)))
+    if not out:
+        try:
+            msg.serialize(io.BytesIO())
+        except Exception as exc:  # genpy raises SerializationError, struct.error, TypeError…
+            out.append((-1, f"the message does not fit {cls._type}: {exc}"))
+    return out
 
 
 _REGISTRIES: Dict[str, Any] = {}  # message definitions by type, built from the classes' full text

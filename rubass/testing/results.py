@@ -1,13 +1,13 @@
 """Running test files: each file's spec, its tests' outcomes, or the error that stopped it."""
 from __future__ import annotations
 
+import difflib
 import os
 import time
 from dataclasses import dataclass, field
 from typing import Dict, List, Optional, Sequence, Set
 
 from ..lang import SpecError, load_spec
-from ..lang.errors import did_you_mean
 from ..lang.model import CheckedSpec
 from .coverage import traced, unknown_covers
 from .declared import declared_model, per_test_models
@@ -129,8 +129,18 @@ def _unknown_covers(spec: CheckedSpec, tf: TestFile, path: str) -> List[str]:
             if name in unknown:
                 line = c.covers_lines[k] if k < len(c.covers_lines) else c.line
                 out.append(f"{path}:{line}: warning: test '{c.name}' covers '{name}', which is no @id or @hazard "
-                           f"of the spec{did_you_mean(name, ids + hazards)}")
+                           f"of the spec{_suggestion(name, ids + hazards)}")
     return out
+
+
+def _suggestion(name: str, known: List[str]) -> str:
+    """`; did you mean 'SR-1'?` for a covers value: the same name in other case first (`sr-1`, `h1`), else
+    the closest one, compared case-insensitively."""
+    by_case = {k.lower(): k for k in reversed(known)}  # the first spelling of each
+    if name.lower() in by_case:
+        return f"; did you mean '{by_case[name.lower()]}'?"
+    close = difflib.get_close_matches(name.lower(), sorted(by_case), n=1, cutoff=0.6)  # as did_you_mean
+    return f"; did you mean '{by_case[close[0]]}'?" if close else ""
 
 
 def shown_path(path: str) -> str:

@@ -17,7 +17,7 @@ from ..lang.model import CheckedSpec
 from ..lang.topicnames import resolve, spellings
 from ..replay.run import replay
 from .cases import UNSET, Case, Expect, MessageInput
-from .messages import MessageError, assign, has_header
+from .messages import MessageError, assign, has_header, in_test_time
 from .yamlpos import TestFileError
 
 NODE_TOPIC = "/rubass_test/node_samples"  # a pseudo topic: node samples as a monitor records them
@@ -25,7 +25,6 @@ TICK_RATE = 50.0  # as `rubass replay` and the monitor's default tick
 # Test time 0 is this absolute time for the engine, so that a message at 0 s has a real header
 # stamp (a zero stamp is unknown, §11); events come back in test time.
 EPOCH = 1000.0
-STAMP = ("header", "stamp")
 
 
 @dataclass
@@ -51,24 +50,9 @@ class _Sample:
         self.data = data
 
 
-def _absolute(stamp: Any) -> Any:
-    """A header stamp in test time as the engine's absolute time; 0 stays the zero stamp."""
-    if isinstance(stamp, (int, float)) and not isinstance(stamp, bool) and stamp != 0:
-        if stamp < 0:
-            raise MessageError(f"'header.stamp' is a time (test time in seconds): {stamp!r} is before the "
-                               f"test's start (0 s)")
-        return EPOCH + stamp
-    return stamp
-
-
 def _test_time(fpath: Tuple[Any, ...], value: Any) -> Any:
-    """`value` to assign at `fpath`, with the message's header stamp in test time however it is
-    written: `header.stamp: T` (a path, or a series of it) or `header: {stamp: T}` (a mapping)."""
-    if fpath == STAMP:
-        return _absolute(value)
-    if fpath == STAMP[:1] and isinstance(value, dict) and "stamp" in value:
-        return {**value, "stamp": _absolute(value["stamp"])}
-    return value
+    """`value` to assign at `fpath`, a header stamp in test time as the engine's absolute time."""
+    return in_test_time(fpath, value, EPOCH)
 
 
 def _stream(spec: CheckedSpec, case: Case, path: str, warnings: List[str],
