@@ -44,10 +44,12 @@ class _Replayed:
         self.given: Dict[str, Tuple[Any, Any, Any]] = {}
         self.wakeups: List[float] = []
 
-    def add(self, stamp: float, text: str) -> Set[str]:
-        """A report into the book; the resolved nodes it contains (ValueError if it is not one)."""
+    def add(self, stamp: float, text: str, caller: Optional[str] = None) -> Set[str]:
+        """A report into the book, from its publisher `caller` (None: not recorded); the resolved nodes it
+        contains (ValueError if it is not one)."""
         report = decode(text)
-        self.book.update(report, stamp)
+        if not self.book.update(report, stamp, caller):
+            return set()  # in another agent's name: ignored, as live
         for node, n in report.nodes.items():
             if self.names.get(node) is not None and self.names[node] not in self.skip:  # only the spec's nodes
                 self.hosts[node] = n.host or report.host
@@ -90,7 +92,7 @@ def agent_samples(stream: Iterable[Record], agent_topics: Set[str], names: Dict[
             yield stamp, topic, msg
             continue
         try:
-            reported = state.add(stamp, msg.data)
+            reported = state.add(stamp, msg.data, getattr(msg, "_connection_header", {}).get("callerid"))
         except (ValueError, AttributeError):
             continue
         yield from state.samples(stamp, reported)

@@ -124,7 +124,8 @@ def run(args: argparse.Namespace) -> int:
         node_topics = node_topics if spec.nodes else []
         agent_topics = agent_topics if spec.nodes else []
         stream: Iterable[Tuple[float, str, Any]] = read(bag, present + node_topics + agent_topics,
-                                                        decode | set(node_topics) | set(agent_topics))
+                                                        decode | set(node_topics) | set(agent_topics),
+                                                        set(agent_topics))  # an agent's report counts from itself only
         if any(names != [name] for name, names in topic_map.items()):  # relative, private or several spellings
             stream = ((t, name, msg) for t, topic, msg in stream for name in topic_map.get(topic, (topic,)))
         if agent_topics:  # multi-host: the agents' reports, for the nodes the monitor's samples do not cover

@@ -184,10 +184,20 @@ class AgentBook:
         self._agents: Dict[str, _Heard] = {}
         self._left: Dict[str, _Left] = {}
         self._warned = -math.inf  # when invalid entries were last warned about
+        self._warned_caller = -math.inf  # when a report in another agent's name was last warned about
         self._lock = threading.Lock()
         self.warn: Callable[[str], None] = warn if warn is not None else _ROSOUT.warning
 
-    def update(self, report: AgentReport, at: float) -> None:
+    def update(self, report: AgentReport, at: float, caller: Optional[str] = None) -> bool:
+        """A report heard at `at`, from the node `caller` (its publisher, from the connection header; None
+        where it is not known); whether it was taken. A report whose publisher is not the agent it names
+        is ignored: a stray or forged report (a leaving one included) must not stand in for a real agent."""
+        if caller is not None and caller != report.agent:
+            if at - self._warned_caller >= WARN_EVERY:
+                self._warned_caller = at
+                self.warn(f"rubass: ignoring a report on {AGENT_TOPIC} published by {caller} in the name of agent "
+                          f"{report.agent}: only an agent's own reports count")
+            return False
         if report.invalid and at - self._warned >= WARN_EVERY:
             self._warned = at
             n = len(report.invalid)
@@ -202,8 +212,9 @@ class AgentBook:
                     if set(g.addresses) & set(report.addresses):
                         del self._left[g.agent]
                 self._left[report.agent] = _Left(report.agent, report.addresses, tuple(sorted(nodes)), at)
-                return
+                return True
             self._agents[report.agent] = _Heard(report, at, old.reports + 1 if old else 1)
+        return True
 
     def _candidates(self, node: str, host: str) -> List[_Heard]:
         """The agents of `host` (by address), else those that reported `node`."""
@@ -219,9 +230,10 @@ class AgentBook:
         candidates = self._candidates(node, host)
         fresh = [h for h in candidates if at < h.stale_at]
         having = [h for h in fresh if node in h.report.nodes]
-        if having:
-            same = [h for h in having if pid is None or h.report.nodes[node].pid in (None, pid)]
-            best = max(same or having, key=lambda h: h.at)
+        if having:  # one that measured the pid answering now first, then one that gave no pid, then any
+            same = [h for h in having if pid is not None and h.report.nodes[node].pid == pid]
+            unsure = [h for h in having if h.report.nodes[node].pid is None]
+            best = max(same or unsure or having, key=lambda h: h.at)
             return best, best.report.nodes[node]
         if fresh:
             best = max(fresh, key=lambda h: h.at)
@@ -286,7 +298,8 @@ class AgentBook:
             for h in self._agents.values():
                 if at < h.stale_at and h.report.host:
                     by_host.setdefault(h.report.host, set()).add(h.report.agent)
-        return [f"agents {', '.join(sorted(a)[:-1])} and {sorted(a)[-1]} both report host {host}"
+        return [f"agents {', '.join(sorted(a)[:-1])} and {sorted(a)[-1]} {'both' if len(a) == 2 else 'all'} report "
+                f"host {host}"
                 for host, a in sorted(by_host.items()) if len(a) > 1]
 
     def silent(self, at: float) -> List[str]:

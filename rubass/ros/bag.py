@@ -95,13 +95,15 @@ def message_classes(bag: Bag, topics: List[str]) -> Dict[str, Any]:
     return out
 
 
-def read(bag: Bag, topics: List[str], decode: Set[str]) -> Iterator[Tuple[float, str, Optional[Any]]]:
-    """(time, topic, message or None) in recorded order; only topics in `decode` are deserialised."""
+def read(bag: Bag, topics: List[str], decode: Set[str], callers: Set[str] = frozenset()  # type: ignore[assignment]
+         ) -> Iterator[Tuple[float, str, Optional[Any]]]:
+    """(time, topic, message or None) in recorded order; only topics in `decode` are deserialised; those in
+    `callers` say who published them (`_connection_header['callerid']`, with our reader only)."""
     if not topics:
         return  # rosbag reads every topic when given none
     if isinstance(bag, BagFile):
         try:
-            yield from bag.read(topics, decode)
+            yield from bag.read(topics, decode, callers)
         except BagFormatError as exc:
             raise BagError(f"{bag.filename}: the bag is corrupt: {exc}") from None
         except NoMessageSupport as exc:

@@ -167,9 +167,11 @@ class BagFile:
         return None
 
     # -- reading -------------------------------------------------------------------------
-    def read(self, topics: Iterable[str], decode: Set[str] = frozenset()  # type: ignore[assignment]
+    def read(self, topics: Iterable[str], decode: Set[str] = frozenset(),  # type: ignore[assignment]
+             callers: Set[str] = frozenset()  # type: ignore[assignment]
              ) -> Iterator[Tuple[float, str, Optional[Any]]]:
-        """(time in s, topic, message or None) in rosbag's order; only topics in decode are deserialised."""
+        """(time in s, topic, message or None) in rosbag's order; only topics in decode are deserialised.
+        Messages of topics in `callers` carry their publisher, as rospy's do: `_connection_header['callerid']`."""
         wanted = set(topics)
         ranks = {c: r for r, c in enumerate(self._connections)}
         nconn = max(len(ranks), 1)
@@ -177,6 +179,8 @@ class BagFile:
         for conn in self._connections.values():
             if conn.topic in wanted:
                 cls = self._class(conn) if conn.topic in decode else None
+                if cls is not None and conn.topic in callers:
+                    cls = _with_caller(cls, conn)
                 conns[conn.id] = (ranks[conn.id], conn.topic, cls)
         chunks = sorted((c for c in self.chunks if any(k in conns for k in c.counts)), key=lambda c: (c.start, c.index))
         held: List[Tuple[float, str, Any]] = []  # messages at or after the next chunk's start
@@ -309,3 +313,12 @@ class BagFile:
 
     def __exit__(self, *exc: Any) -> None:
         self.close()
+
+
+def _with_caller(cls: Any, conn: Connection) -> Any:
+    """A class of `cls` whose messages say who published them (the connection's callerid), at no cost
+    per message: the connection header is a class attribute of one subclass per connection."""
+    caller = conn.header.get("callerid", b"").decode("utf-8", "replace")
+    if not caller:  # written by a tool, not recorded from a publisher: who published is not known
+        return cls
+    return type(cls.__name__, (cls,), {"__slots__": (), "_connection_header": {"callerid": caller}})

@@ -310,7 +310,8 @@ class Monitor(Reloading):
 
     def _on_agent(self, msg: String) -> None:
         try:
-            self.agents.update(decode_agent_report(msg.data), time.monotonic())
+            caller = getattr(msg, "_connection_header", {}).get("callerid") or None  # the publishing node
+            self.agents.update(decode_agent_report(msg.data), time.monotonic(), caller)
         except ValueError as exc:
             rospy.logwarn_throttle(10, f"rubass: ignoring a bad report on {AGENT_TOPIC}: {exc}")
 

@@ -27,13 +27,18 @@ def agent_report(t, cpu, pid=42):
                                              "why": "alive"}]}))
 
 
-def run(tmp_path, items):
+def run(tmp_path, items, caller=None):
+    """Replay `items` recorded in a bag; `caller`: the agents' topic recorded as published by that node."""
     (tmp_path / "lib.yaml").write_text(LIB)
     (tmp_path / "s.rbs").write_text(SPEC)
     bag = str(tmp_path / "run.bag")
     with rosbag.Bag(bag, "w") as b:
         for t, topic, msg in items:
-            b.write(topic, msg, rospy.Time.from_sec(T0 + t))
+            header = None
+            if caller is not None and topic == "/rubass/agent_samples":
+                header = {"topic": topic, "type": msg._type, "md5sum": msg._md5sum,
+                          "message_definition": msg._full_text, "callerid": caller}
+            b.write(topic, msg, rospy.Time.from_sec(T0 + t), connection_header=header)
     proc = subprocess.run([sys.executable, "-m", "rubass", "replay", str(tmp_path / "s.rbs"), bag, "--json"],
                           cwd=ROOT, capture_output=True, text=True, timeout=120,
                           env=dict(os.environ, PYTHONPATH=ROOT))
@@ -60,3 +65,13 @@ def test_the_monitors_own_samples_win_over_an_agents_for_the_same_node(tmp_path)
     lines, _ = run(tmp_path, sorted(mon + agent, key=lambda x: x[0]))
     assert not [x for x in lines if x["event"] == "start"]
     assert {x["value"] for x in lines if x["event"] == "rule"} <= {None, False}
+
+
+@pytest.mark.parametrize("caller,starts", [("/rubass_agent_arm", 1), ("/g", 0)])
+def test_a_report_counts_only_from_the_agent_it_names_as_live(tmp_path, caller, starts):
+    """Live, the monitor takes a report only from the node it names (its connection's callerid): a
+    stray or forged one, a leaving one included, never stands in for the agent. Replay does the same."""
+    items = [(i * 0.1, "/rubass/agent_samples", agent_report(i * 0.1, 0.9)) for i in range(10)]
+    items.append((2.0, "/other", String(data="end")))
+    lines, _ = run(tmp_path, items, caller=caller)
+    assert len([x for x in lines if x["event"] == "start"]) == starts, lines

@@ -182,3 +182,29 @@ def test_replay_after_a_leaving_report_reads_unknown_at_once():
                                                         [node_entry("/hog", 0, True, 0.5, 1.0, 42, "", "")]))),
               (0.5, "/rubass/agent_samples", Msg(encode("/b", HOST, [HOST], 0, 1.0, 2, [], leaving=True)))]
     assert replay(stream, end=10.0) == [(0.0, 0.5), (0.5, None)]
+
+
+def test_a_report_published_by_another_node_than_the_agent_it_names_is_ignored():
+    """The acceptance re-sweep: a leaving report forged in the real agent's name dropped it (the stop
+    released for 1 s); a plausible fake with no pid beat the agent that measured the answering pid."""
+    warned = []
+    book = AgentBook(warn=warned.append)
+    assert book.update(report(), 10.0, caller="/rubass_agent_b")
+    forged_leaving = report(nodes=(), leaving=True)
+    assert not book.update(forged_leaving, 10.02, caller="/g")
+    assert book.lookup("/hog", HOST, 42, 10.05)[0] == 0.84  # the real agent is still heard
+    assert len(warned) == 1 and "published by /g in the name of agent /rubass_agent_b" in warned[0]
+    assert book.update(forged_leaving, 10.06, caller=None)  # who published it is not known (a tool's bag)
+
+
+def test_a_fake_without_a_pid_does_not_beat_the_agent_that_measured_the_answering_pid():
+    book = AgentBook(warn=lambda text: None)
+    low = fake([{"node": "/hog", "time": 0, "alive": True, "cpu": 0.0, "memory": 1000.0}])
+    assert alternate(book, low) == [0.84] * 20
+
+
+def test_three_agents_on_one_host_all_report_it():
+    book = AgentBook(warn=lambda text: None)
+    for i, name in enumerate(("/a", "/b", "/c")):
+        book.update(report(agent=name), 10.0 + i * 0.01)
+    assert book.conflicts(10.05) == [f"agents /a, /b and /c all report host {HOST}"]
