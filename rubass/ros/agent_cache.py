@@ -5,7 +5,8 @@ knows only the nodes started since, so an agent restarted then would never learn
 that kept running, and their cpu() and memory() would stay unknown. The agent therefore keeps
 the nodes of its host it has discovered (node name -> XML-RPC URI) in a small JSON file,
 $ROS_HOME/rubass/agent_<host>.json, reloads it at start, and keeps an entry only while the node
-at that URI answers getName with that name (`check`). No rospy: the file and the question only.
+at that URI answers getName with that name, or, for a C++ node (roscpp has no getName), getPid
+(`check`). No rospy: the file and the question only.
 """
 from __future__ import annotations
 
@@ -54,11 +55,22 @@ def save(path: str, nodes: Dict[str, str]) -> None:
 def check(name: str, uri: str, caller_id: str, timeout: float) -> Optional[bool]:
     """Whether the node at `uri` is `name`: True if it answers getName with it, False if something
     else answers there or nothing does (refused: the node is gone), None if no answer came within
-    `timeout` (a hung node: neither kept as known nor forgotten)."""
+    `timeout` (a hung node: neither kept as known nor forgotten). A C++ node (roscpp) has no getName:
+    one that answers getPid there is taken to be it (its name cannot be asked)."""
+    caller = rpc.Caller(uri, timeout, keep_alive=False)
     try:
-        code, _, answer = rpc.Caller(uri, timeout, keep_alive=False).call("getName", caller_id)
+        code, _, answer = caller.call("getName", caller_id)
+        return code == 1 and answer == name
+    except xmlrpc.client.Fault:  # a server that does not know getName: roscpp's slave API
+        pass
     except socket.timeout:
         return None
     except (OSError, xmlrpc.client.Error, ValueError):
         return False
-    return code == 1 and answer == name
+    try:
+        code, _, _ = caller.call("getPid", caller_id)
+    except socket.timeout:
+        return None
+    except (OSError, xmlrpc.client.Error, ValueError):
+        return False
+    return code == 1

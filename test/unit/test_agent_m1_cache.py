@@ -74,3 +74,16 @@ def test_a_node_is_kept_only_while_it_answers_with_its_name(fake_node):
 def test_a_hung_node_is_neither_kept_as_known_nor_forgotten(fake_node):
     fake_node["hang"] = True
     assert agent_cache.check("/kept", fake_node["uri"], "/agent", 0.1) is None
+
+
+def test_a_cpp_node_without_get_name_is_kept_while_it_answers_get_pid():
+    """roscpp's slave API has getPid but no getName (a Fault): every C++ node was dropped from the cache."""
+    server = SimpleXMLRPCServer(("127.0.0.1", 0), logRequests=False)
+    server.register_function(lambda caller: (1, "", 4242), "getPid")
+    threading.Thread(target=server.serve_forever, daemon=True).start()
+    try:
+        uri = f"http://127.0.0.1:{server.server_address[1]}/"
+        assert agent_cache.check("/cpp_node", uri, "/agent", 0.5) is True
+    finally:
+        server.shutdown()
+        server.server_close()
