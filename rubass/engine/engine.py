@@ -23,7 +23,7 @@ from .events import Event, starts_first
 from .operators import ForOp, LatchOp, WithinOp
 from .readings import STAMP, laser_limits, stamp_seconds
 from .store import Store
-from .values import UNKNOWN
+from .values import UNKNOWN, UNREADABLE
 
 
 class _Node:
@@ -218,7 +218,10 @@ class Engine:
 
     def _store_message(self, topic: str, now: float, msg: Any, changed: Set[Any]) -> None:
         store = self.store
-        store.arrive(topic, now)
+        if msg is UNREADABLE:  # not data: a dead sensor beside a publisher of another type still goes stale
+            msg = UNKNOWN
+        else:
+            store.arrive(topic, now)
         fields = store.fields
         for number, slot, cell, path, key in self._reads.get(topic, ()):
             value = self._read(topic, path, msg, key)

@@ -16,7 +16,7 @@ import genpy.dynamic
 import roslib.message
 import rospy
 
-from ..engine.values import UNKNOWN
+from ..engine.values import UNKNOWN, UNREADABLE
 from ..lang import ast
 from ..lang.fielduse import field_needs
 from ..lang.model import CheckedSpec
@@ -56,7 +56,7 @@ class TopicState:
     subscriber: Optional[rospy.Subscriber] = None  # None until the registrar has made it
     # (md5, class, type) of the type evaluated, as one value: a callback of another publisher's
     # thread reads it in one step, never a class of one type beside the md5 of another
-    decoder: Tuple[str, Any, str] = ("", None, "")
+    decoder: Tuple[str, Any, str, bool] = ("", None, "", False)  # and whether no field the spec reads is in it
     gone: bool = False  # a reload dropped it (its subscription is dropped by the registrar)
     kinds: Dict[str, "topictypes.Kind"] = field(default_factory=dict)  # md5 -> a type seen now
     callers: Dict[str, Tuple[str, float]] = field(default_factory=dict)  # publisher -> (md5, newest message)
@@ -147,8 +147,12 @@ class TopicWatcher:
                     with self._types_lock:
                         for kind in state.kinds.values():
                             kind.problems = self._check(state, kind.cls, kind.type)
+                            kind.unreadable = self._unreadable(state, kind)
                         if state.cls is not None:
                             state.errors = self._check(state, state.cls, state.type)
+                        current = state.kinds.get(state.md5)
+                        if current is not None:  # the new spec may read other fields of it
+                            state.decoder = state.decoder[:3] + (current.unreadable,)
         if self.clock is None and not _rostime.is_wallclock() and _rostime._rostime_initialized:
             self.clock = ClockStall(ros_now, time.time, self.log)
             threading.Thread(target=self._watch_clock, name="rubass-clock", daemon=True).start()
@@ -256,16 +260,17 @@ class TopicWatcher:
             return
         header = getattr(raw, "_connection_header", None) or {}
         md5 = header.get("md5sum", "")
-        md5_now, cls, type_name = state.decoder
+        md5_now, cls, type_name, unreadable = state.decoder
         if md5 != md5_now or (state.mixed is not None and wall - state.checked >= RECHECK):
             with self._types_lock:
                 evaluated = topictypes.admit(state, header, wall, self._new_kind, self.log)
                 kind = state.kinds.get(md5)
-                cls, type_name = (kind.cls, kind.type) if kind is not None else (None, header.get("type", "?"))
+                cls, type_name, unreadable = ((kind.cls, kind.type, kind.unreadable) if kind is not None
+                                              else (None, header.get("type", "?"), True))
             if not evaluated:
                 return  # another type's message, while publishers of a type the spec can read are on
-        if cls is None:
-            self._send(state, now, UNKNOWN, wall, 0)
+        if unreadable:  # no field the spec reads is in its type: unknown, and no data for age()/frequency()
+            self._send(state, now, UNREADABLE, wall, 0)
             return
         try:
             msg = cls().deserialize(raw._buff)  # this message's own type's class (review: not state.cls)
@@ -284,6 +289,7 @@ class TopicWatcher:
         type_name, md5 = header.get("type", "?"), header.get("md5sum", "")
         cls = self._class(type_name, md5, header.get("message_definition", ""))
         kind = topictypes.Kind(type_name, md5, cls, self._check(state, cls, type_name))
+        kind.unreadable = self._unreadable(state, kind)
         for e in ([] if cls is not None else [f"cannot load message type {type_name}"]) + kind.problems:
             self.log("error", f"topic {state.resolved}: {e}")
         return kind
@@ -300,6 +306,13 @@ class TopicWatcher:
                 out.append(f"{' and '.join(owners)} reads {state.spec_name}{ast.path_suffix(path)}, but in {type_name}: "
                            f"{problem}; its value stays unknown")
         return out
+
+    @staticmethod
+    def _unreadable(state: TopicState, kind: topictypes.Kind) -> bool:
+        """Whether none of the fields the spec reads on this topic can be read in `kind` (one problem
+        each, or no class at all): its messages are then no data (UNREADABLE)."""
+        read = sum(1 for p in state.paths if p not in state.implicit)
+        return kind.cls is None or (read > 0 and len(kind.problems) >= read)
 
     def _class(self, type_name: str, md5: str, definition: str) -> Any:
         cls = self._classes.get(md5)

@@ -31,6 +31,7 @@ class Kind:
     cls: Any  # None: the type cannot be loaded
     problems: List[str]  # what the spec's fields cannot read in this type
     last: float = 0.0  # wall time of its newest message
+    unreadable: bool = False  # none of the spec's fields can be read in it: its messages are no data
 
     @property
     def fits(self) -> bool:
@@ -126,7 +127,7 @@ def over(state: Any, left: str) -> str:
 def adopt(state: Any, kind: Kind, log: Log, change: bool) -> None:
     """Evaluate `kind`'s messages from now on; a change of the only type is logged and kept."""
     old = state.type
-    state.decoder = (kind.md5, kind.cls, kind.type)  # one value: read by callbacks without the lock
+    state.decoder = (kind.md5, kind.cls, kind.type, kind.unreadable)  # one value: read by callbacks without the lock
     state.errors = ([] if kind.cls is not None else [f"cannot load message type {kind.type}"]) + list(kind.problems)
     if change and old and old != kind.type:
         log("error", f"topic {state.resolved} changed type from {old} to {kind.type}")
