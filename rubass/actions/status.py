@@ -66,14 +66,15 @@ def build(spec: CheckedSpec, rules: Dict[str, Any], active: List[int], topics: D
         for key in keys:
             v = rules.get(key)
             values.append((key.split(".", 1)[1], _text(v)))
+            reasons = unknown_reasons(spec, key, topics, nodes, field_errors)
+            # a field it cannot read is an error whatever its value (`false and unknown` is false)
+            errors += [r for r in reasons if "reads" in r or "changed type" in r or "deserialise" in r]
             if v is True:
                 true_rules.append(key)
             elif v is not False:
-                reasons = unknown_reasons(spec, key, topics, nodes, field_errors)
                 unknown.append(key)
                 if reasons:
                     values.append((f"{key.split('.', 1)[1]} unknown because", "; ".join(reasons)))
-                errors += [r for r in reasons if "reads" in r or "changed type" in r or "deserialise" in r]
         if errors:  # named: the rule, the field and what is wrong
             first = min(set(errors), key=lambda e: ("changed type" in e, e))  # what a rule cannot read first
             level, msg = ERROR, f"DATA ERROR: {first}" + (
@@ -113,6 +114,10 @@ def build(spec: CheckedSpec, rules: Dict[str, Any], active: List[int], topics: D
     if monitor.get("agents claiming one host", "none") not in ("none", ""):  # whose values are used is unclear
         level = max(level, WARN)
         msg += f" ({monitor['agents claiming one host']})"
+    held = monitor.get("held by replaced rules (until ~reset)", "")
+    if held:  # the robot is held by rules no longer in the spec: only ~reset releases them
+        level = max(level, WARN)
+        msg += f" (HOLDING until ~reset, for rules a reload replaced: {held})"
     if monitor.get("last reload error"):
         msg += " (the last reload was rejected; the previous rules still run)"
     if failing:

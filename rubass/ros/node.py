@@ -3,6 +3,7 @@ Parameters are read and checked here; a bad one is a FATAL line and exit 1, neve
 from __future__ import annotations
 
 import os
+import signal
 import sys
 from typing import List, Optional
 
@@ -24,6 +25,9 @@ def main(argv: Optional[List[str]] = None) -> int:
     if wants_help(argv):
         sys.stdout.write(USAGE)
         return 0
+    # SIGHUP reloads once the monitor runs (its handler replaces this one); before, its default would end it
+    signal.signal(signal.SIGHUP, lambda signum, frame: sys.stderr.write(
+        "rubass: SIGHUP before the monitor started: nothing to reload yet (the spec is read when it starts)\n"))
     code = init_node("rubass", argv, False, lambda text: sys.stderr.write(f"rubass: {text}\n"))
     if code is not None:
         return code  # Monitor handles SIGINT/SIGTERM once it runs; before, a signal ends the wait for the master

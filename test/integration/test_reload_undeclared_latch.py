@@ -21,6 +21,11 @@ def test_a_spec_that_stops_declaring_a_latched_active_action_reloads_and_the_sto
     out = ros.call("/rubass/reload")
     assert "reloaded" in out.stdout, out.stdout
     assert len(stops_within(ros, 1.0)) >= 10, "the latched stop goes on after the reload"
+    rec = ros.probe({"listen": [{"topic": "/diagnostics", "type": "diagnostic_msgs/DiagnosticArray"}],
+                     "steps": [{"sleep": 2.5}]})
+    mon = [s for r in rec if r["kind"] == "recv" for s in r["msg"]["status"] if s["name"] == "rubass: monitor"]
+    assert mon and mon[-1]["level"] >= 1 and "HOLDING until ~reset, for rules a reload replaced: stop" in \
+        mon[-1]["message"], mon[-1:]  # the robot is held: /diagnostics says by what (it said OK, none active)
     out = ros.call("/rubass/reset")
     assert "released 1 latched behaviour" in out.stdout, out.stdout
     assert len(stops_within(ros, 1.0)) == 0, "~reset ends it"

@@ -79,3 +79,21 @@ def test_a_monitor_started_before_its_master_waits_for_it_then_enforces(ros, tmp
     ros.wait_service("/rubass/reset", mon)
     assert rosharness.brake_after(ros, 2.0), ros.log(mon)
     assert "Traceback" not in ros.log(mon)
+
+
+def test_a_sighup_while_waiting_for_the_master_does_not_end_the_monitor(tmp_path):
+    env = _env(tmp_path)
+    proc = subprocess.Popen([sys.executable, os.path.join(ROOT, "scripts", "monitor"), "_spec:=/nonexistent.rbs"],
+                            env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, start_new_session=True)
+    try:
+        assert "waiting for the ROS master" in proc.stderr.readline()
+        proc.send_signal(signal.SIGHUP)  # a reload asked too early: its default action ended the process
+        time.sleep(1.0)
+        assert proc.poll() is None, "SIGHUP ended the monitor"
+        proc.send_signal(signal.SIGTERM)
+        out, err = proc.communicate(timeout=15)
+    finally:
+        if proc.poll() is None:
+            os.killpg(proc.pid, signal.SIGKILL)
+            proc.wait()
+    assert proc.returncode == 0 and "nothing to reload yet" in err and "Traceback" not in err, err
