@@ -104,5 +104,6 @@ class LiveTypeCheck:
                 new = [e for e in errors if e not in self._said]
                 self._said.update(new)
             for e in new:
-                self.log("error", "rubass: the spec does not fit the message types its topics carry (the rule is "
-                                  f"still evaluated on the numbers as written; fix the spec and reload):\n{e}")
+                self.log("error", "rubass: the spec does not fit the message types its topics carry (fix the spec "
+                                  "and reload; a unit or kind error: the rule is still evaluated on the numbers as "
+                                  f"written; a field the type lacks: a data error, the rule unknown):\n{e}")

@@ -95,6 +95,7 @@ class Monitor(Reloading):
         self._exit = threading.Event()
         self.spec: Optional[CheckedSpec] = None  # None while not enforcing (no usable spec yet)
         self.runners: Dict[str, ActionRunner] = {}
+        self.retired_failures = 0  # failed attempts of runners a reload replaced: `failed action attempts` is since start
         self.loop: Optional[EngineLoop] = None
         self.load_error = ""  # why the monitor is not enforcing, while it is not
 
@@ -369,10 +370,11 @@ class Monitor(Reloading):
             return sum(e.kind == "release" for e in events) + n
 
         released = loop.call(do)
-        still = loop.call(lambda engine: engine.active_behaviours())
+        still = loop.call(lambda engine: [engine.spec.behaviours[i - 1].label for i in engine.active_behaviours()
+                                          if engine.spec.behaviours[i - 1].latched])  # what ~reset concerns
         msg = f"released {released} latched behaviour{'s' if released != 1 else ''}"
         if still:
-            msg += f"; still active (cause present): {', '.join(str(i) for i in still)}"
+            msg += f"; latched and still active (cause present): {', '.join(still)}"
         rospy.loginfo("rubass: reset: %s", msg)
         return True, msg
 
@@ -393,7 +395,7 @@ class Monitor(Reloading):
         topics = {name: {"messages": s.messages, "errors": s.errors, "type": s.type}
                   for s in self.watcher.status() for name in (s.spec_name,) + s.aliases}  # every spelling
         nodes = {s.spec_name: {"why": s.why} for s in self.sampler.status.values()}
-        failures = sum(r.stats.failures for r in self.runners.values())
+        failures = self.retired_failures + sum(r.stats.failures for r in self.runners.values())
         lat = sorted(self.dispatcher.latencies)
         monitor: Dict[str, Any] = {
             "spec": self.spec.path, "reloads": self.reloads, "rejected reloads": self.rejected,

@@ -142,6 +142,7 @@ class Reloading:
                 self.sampler.stop()
                 self.sampler = self._sampler(spec)
             dropped = [r for n, r in self.runners.items() if runners.get(n) is not r]
+            self.retired_failures += sum(r.stats.failures for r in dropped)  # the record is since start
             self.spec, self.runners = spec, runners
             for runner in dropped:
                 runner.stop()
