@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import heapq
 import json
-from typing import Any, Dict, Iterable, Iterator, List, Optional, Set, Tuple
+from typing import Any, Callable, Dict, Iterable, Iterator, List, Optional, Set, Tuple
 
 from ..ros.agentbook import AgentBook, decode, stale_at
 
@@ -37,8 +37,9 @@ def _sample(node: str, alive: Any, cpu: Any, memory: Any) -> _Sample:
 class _Replayed:
     """The book on the recording's clock, and the last sample given for each spec node."""
 
-    def __init__(self, names: Dict[str, str], skip: Set[str]) -> None:
-        self.book = AgentBook(warn=lambda text: None)  # a replay reads past reports: nothing to warn about
+    def __init__(self, names: Dict[str, str], skip: Set[str], warn: Callable[[str], None]) -> None:
+        self.book = AgentBook(warn=warn)
+        self.agents: Set[str] = set()  # publishers seen reporting in their own name: agents
         self.names, self.skip = names, skip
         self.hosts: Dict[str, str] = {}  # resolved node -> its host, from the latest entry naming it
         self.given: Dict[str, Tuple[Any, Any, Any]] = {}
@@ -48,6 +49,12 @@ class _Replayed:
         """A report into the book, from its publisher `caller` (None: not recorded); the resolved nodes it
         contains (ValueError if it is not one)."""
         report = decode(text)
+        if caller == report.agent:
+            self.agents.add(caller)
+        elif caller in self.agents:
+            # `rosbag filter`/`compress` write one connection per topic, under its first publisher's name:
+            # an agent never reports in another's name, so that name says nothing of who published
+            caller = None
         if not self.book.update(report, stamp, caller):
             return set()  # in another agent's name: ignored, as live
         for node, n in report.nodes.items():
@@ -69,13 +76,15 @@ class _Replayed:
 
 
 def agent_samples(stream: Iterable[Record], agent_topics: Set[str], names: Dict[str, str], skip: Set[str],
-                  end: float) -> Iterator[Record]:
+                  end: float, warn: Callable[[str], None] = lambda text: None,
+                  keep: Set[str] = frozenset()) -> Iterator[Record]:  # type: ignore[assignment]
     """`stream` with each agent report replaced by node samples on SAMPLES.
 
     names: resolved node name -> the spec's name; skip: spec names left to the monitor's own
-    samples; end: the recording's end (bag time), past which no expiry is emitted.
+    samples; end: the recording's end (bag time), past which no expiry is emitted; warn: what the
+    monitor would log (a report ignored); keep: agent topics the spec reads, passed on as well.
     """
-    state = _Replayed(names, skip)
+    state = _Replayed(names, skip, warn)
     done = -1.0
 
     def expire(until: float) -> Iterator[Record]:
@@ -91,6 +100,8 @@ def agent_samples(stream: Iterable[Record], agent_topics: Set[str], names: Dict[
         if topic not in agent_topics:
             yield stamp, topic, msg
             continue
+        if topic in keep:  # the spec reads the agents' topic itself (age(), frequency())
+            yield stamp, topic, msg
         try:
             reported = state.add(stamp, msg.data, getattr(msg, "_connection_header", {}).get("callerid"))
         except (ValueError, AttributeError):

@@ -126,8 +126,6 @@ def run(args: argparse.Namespace) -> int:
         stream: Iterable[Tuple[float, str, Any]] = read(bag, present + node_topics + agent_topics,
                                                         decode | set(node_topics) | set(agent_topics),
                                                         set(agent_topics))  # an agent's report counts from itself only
-        if any(names != [name] for name, names in topic_map.items()):  # relative, private or several spellings
-            stream = ((t, name, msg) for t, topic, msg in stream for name in topic_map.get(topic, (topic,)))
         if agent_topics:  # multi-host: the agents' reports, for the nodes the monitor's samples do not cover
             from .agents import SAMPLES, agent_samples
 
@@ -136,8 +134,12 @@ def run(args: argparse.Namespace) -> int:
             except BagError as exc:
                 print(f"rubass replay: error: {exc}", file=sys.stderr)
                 return 1
-            stream = agent_samples(stream, set(agent_topics), {resolve(n): n for n in spec.nodes}, skip, info.end)
+            stream = agent_samples(stream, set(agent_topics), {resolve(n): n for n in spec.nodes}, skip, info.end,
+                                   lambda text: print(f"rubass replay: warning: {text}", file=sys.stderr),
+                                   keep=set(agent_topics) & set(present))  # a spec may time the reports too
             node_topics = node_topics + [SAMPLES]
+        if any(names != [name] for name, names in topic_map.items()):  # relative, private or several spellings
+            stream = ((t, name, msg) for t, topic, msg in stream for name in topic_map.get(topic, (topic,)))
         try:
             with _fewer_collections():
                 _, events = replay(spec, stream, info.start, info.end, args.rate, node_topics)

@@ -321,4 +321,6 @@ def _with_caller(cls: Any, conn: Connection) -> Any:
     caller = conn.header.get("callerid", b"").decode("utf-8", "replace")
     if not caller:  # written by a tool, not recorded from a publisher: who published is not known
         return cls
-    return type(cls.__name__, (cls,), {"__slots__": (), "_connection_header": {"callerid": caller}})
+    sub = type(cls.__name__, (cls,), {"__slots__": (), "_connection_header": {"callerid": caller}})
+    sub.__slots__ = cls.__slots__  # genpy walks __slots__ for its fields (==, str, copy): the class's own
+    return sub

@@ -75,3 +75,33 @@ def test_a_report_counts_only_from_the_agent_it_names_as_live(tmp_path, caller, 
     items.append((2.0, "/other", String(data="end")))
     lines, _ = run(tmp_path, items, caller=caller)
     assert len([x for x in lines if x["event"] == "start"]) == starts, lines
+
+
+def test_a_filtered_bag_whose_topic_names_its_first_agent_keeps_every_agents_reports(tmp_path):
+    """`rosbag filter`/`compress` write one connection per topic, under its first publisher's name: the
+    reports of the other agents then carry that agent's name as publisher, and were all ignored."""
+    other = String(data=agent_report(0.0, 0.9).data.replace("/rubass_agent_arm", "/rubass_agent_b"))
+    first_agent = String(data=json.dumps({"agent": "/rubass_agent_arm", "host": "10.200.0.9", "period": 0.1,
+                                          "time": T0, "nodes": []}))
+    items = [(0.0, "/rubass/agent_samples", first_agent)]
+    items += [(0.05 + i * 0.1, "/rubass/agent_samples", String(data=other.data)) for i in range(10)]
+    items.append((2.0, "/other", String(data="end")))
+    lines, stderr = run(tmp_path, items, caller="/rubass_agent_arm")
+    assert len([x for x in lines if x["event"] == "start"]) == 1, (lines, stderr)
+
+
+def test_a_spec_that_times_the_agents_topic_sees_its_reports(tmp_path):
+    items = [(i * 0.1, "/rubass/agent_samples", agent_report(i * 0.1, 0.2)) for i in range(30)]
+    (tmp_path / "lib.yaml").write_text(LIB)
+    spec = ('import "lib.yaml";\naction primitive stop;\n'
+            "entity arm: hog { rules: busy: cpu(node hog) > 50 %; silent: age(topic /rubass/agent_samples) > 0.5 s; }\n"
+            "if (arm.busy or arm.silent) then { stop; }\n")
+    bag = str(tmp_path / "run.bag")
+    with rosbag.Bag(bag, "w") as b:
+        for t, topic, msg in items:
+            b.write(topic, msg, rospy.Time.from_sec(T0 + t))
+    (tmp_path / "t.rbs").write_text(spec)
+    proc = subprocess.run([sys.executable, "-m", "rubass", "replay", str(tmp_path / "t.rbs"), bag, "--json"],
+                          cwd=ROOT, capture_output=True, text=True, timeout=120, env=dict(os.environ, PYTHONPATH=ROOT))
+    lines = [json.loads(line) for line in proc.stdout.splitlines()]
+    assert proc.returncode == 0 and not [x for x in lines if x["event"] == "start"], (lines, proc.stderr)

@@ -339,3 +339,22 @@ def test_replay_of_a_bag_neither_reader_can_read_is_a_one_line_error(tmp_path, w
     assert proc.returncode == 1 and "Traceback" not in proc.stderr
     assert proc.stderr.startswith(f"rubass replay: error: {path}: ") and "compression" in proc.stderr
     assert len(proc.stderr.strip().splitlines()) == 1
+
+
+def test_messages_of_a_callers_topic_say_who_published_them_and_stay_whole_messages(tmp_path):
+    path = str(tmp_path / "c.bag")
+    with rosbag.Bag(path, "w") as b:
+        header = {"topic": "/rubass/agent_samples", "type": String._type, "md5sum": String._md5sum,
+                  "message_definition": String._full_text, "callerid": "/rubass_agent_a"}
+        for i in range(3):
+            b.write("/rubass/agent_samples", String(data=f"r{i}"), rospy.Time(1, i), connection_header=header)
+    with BagFile(path) as bag:
+        got = [m for _, _, m in bag.read(["/rubass/agent_samples"], {"/rubass/agent_samples"},
+                                        {"/rubass/agent_samples"})]
+        plain = [m for _, _, m in bag.read(["/rubass/agent_samples"], {"/rubass/agent_samples"})]
+    assert [m._connection_header["callerid"] for m in got] == ["/rubass_agent_a"] * 3
+    import copy
+
+    assert copy.deepcopy(got[0]).data == "r0" and got[0] != got[1]  # genpy walks __slots__ for its fields
+    assert str(got[1]) == str(String(data="r1")) and type(got[0])(data="r0") == got[0]
+    assert not hasattr(plain[0], "_connection_header") and plain[0].data == "r0"  # only where asked
