@@ -342,6 +342,11 @@ def _run(rate: float, discover_period: float, stop: threading.Event) -> int:
             if left:
                 return
             left.append(True)
+            if "new node registered with same name" in reason:  # the master's words: another agent is us now
+                rospy.logwarn("rubass agent: another node took this agent's name: it reports from now on "
+                              "(no leaving report, which would make the monitor drop it)")
+                watch.stop()
+                return
             try:
                 pub.publish(String(data=agent.leaving(rospy.get_rostime().to_sec())))
                 time.sleep(LEAVING_FLUSH)
