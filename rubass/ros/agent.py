@@ -40,6 +40,7 @@ from urllib.parse import urlparse
 import psutil
 
 from ..engine.values import UNKNOWN
+from ..lang.errors import counted
 from . import agent_cache, rpc
 from .agentbook import AGENT_TOPIC, STALE_PERIODS, encode, is_loopback, node_entry
 from .nodes import NodeSampler, NodeStatus
@@ -123,7 +124,7 @@ class Agent:
                 self.sampler._uris[name] = uri
                 self.sampler.status.setdefault(name, NodeStatus(name, name))
         if kept:
-            self.log("info", f"rubass agent: {len(kept)} nodes known from {self.cache_file} still answer: "
+            self.log("info", f"rubass agent: {counted(len(kept), 'node')} known from {self.cache_file} still answer: "
                              + ", ".join(n for n, _ in kept))
         self._save_cache()
         return len(kept)

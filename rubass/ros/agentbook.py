@@ -29,6 +29,7 @@ from typing import Any, Callable, Dict, List, Optional, Set, Tuple, Union
 from urllib.parse import urlparse
 
 from ..engine.values import UNKNOWN
+from ..lang.errors import counted
 
 AGENT_TOPIC = "/rubass/agent_samples"
 STALE_PERIODS = 3.0
@@ -321,6 +322,6 @@ class AgentBook:
         with self._lock:
             left = sorted(self._left.values(), key=lambda g: g.agent)
         parts = [f"{h.report.agent} on {h.report.host or '?'}: {'SILENT' if at >= h.stale_at else 'ok'}, "
-                 f"{len(h.report.nodes)} nodes, last report {at - h.at:.1f} s ago" for h in heard]
+                 f"{counted(len(h.report.nodes), 'node')}, last report {at - h.at:.1f} s ago" for h in heard]
         parts += [f"{g.agent}: left {at - g.at:.1f} s ago" for g in left if at < g.at + COVERED_DROP_AFTER]
         return "; ".join(parts) or "none heard"

@@ -182,7 +182,7 @@ def test_a_restarted_agent_still_knows_the_nodes_after_a_master_restart(ros):
     assert entry(found[-1], "/gone") is None, found[-1]
     assert found[-1]["seq"] < 30  # from its start, not after a minute
     assert "/gone" not in json.load(open(cache))["nodes"]
-    assert "nodes known from" in ros.log(second) and "/kept" in ros.log(second), ros.log(second)
+    assert " known from " in ros.log(second) and "/kept" in ros.log(second), ros.log(second)
 
 
 def test_the_monitor_forgets_an_agent_that_left_rather_than_report_it_silent(ros):

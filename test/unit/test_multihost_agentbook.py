@@ -49,7 +49,7 @@ def test_lookup_uses_a_fresh_report_of_the_nodes_host():
     book.update(decode(report()), at=10.0)
     assert book.lookup("/ctrl", "10.200.1.2", 42, at=10.25) == (0.5, 1e6, "alive")
     assert book.silent(10.25) == []
-    assert "ok, 1 nodes" in book.summary(10.25)
+    assert "ok, 1 node," in book.summary(10.25)
 
 
 def test_a_report_older_than_three_periods_is_unknown_and_names_the_silent_agent():
