@@ -11,6 +11,7 @@ from typing import Any, Callable, Dict, List, Sequence
 from ..engine import Engine, Event
 from .base import Context
 from .latches import Latch, LatchFile, holders, load
+from .status import HELD
 
 Log = Callable[[str, str], None]
 Report = Callable[[Dict[str, Any]], None]
@@ -88,7 +89,7 @@ class LatchKeeper:
     def status(self) -> Dict[str, str]:
         out: Dict[str, str] = {}
         if self.restored:
-            out["latched at start (until ~reset)"] = "; ".join(f"{', '.join(r.actions)} ({r.holder})"
+            out[HELD[1]] = "; ".join(f"{', '.join(r.actions)} ({r.holder})"
                                                                 for r in self.restored)
         errors = self.problems + ([self.file.error] if self.file.error else [])
         if errors:

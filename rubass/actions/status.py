@@ -51,6 +51,11 @@ def unknown_reasons(spec: CheckedSpec, rule_key: str, topics: Dict[str, Dict[str
     return sorted(set(why))
 
 
+# what holds the robot apart from the active behaviours: latched actions kept across a reload or a clock
+# jump, and those restored at start (actions/keeper.py)
+HELD = ("held over a reload or clock jump (until ~reset)", "latched at start (until ~reset)")
+
+
 def build(spec: CheckedSpec, rules: Dict[str, Any], active: List[int], topics: Dict[str, Dict[str, Any]],
           nodes: Dict[str, Dict[str, Any]], field_errors: Dict[Tuple[str, str], str],
           monitor: Dict[str, Any], failing: Sequence[Tuple[str, str]] = ()) -> List[Entry]:
@@ -68,10 +73,11 @@ def build(spec: CheckedSpec, rules: Dict[str, Any], active: List[int], topics: D
             values.append((key.split(".", 1)[1], _text(v)))
             reasons = unknown_reasons(spec, key, topics, nodes, field_errors)
             # a field it cannot read is an error whatever its value (`false and unknown` is false)
-            errors += [r for r in reasons if "reads" in r or "changed type" in r or "deserialise" in r]
+            errors += [r for r in reasons if "reads" in r or "deserialise" in r]
             if v is True:
                 true_rules.append(key)
             elif v is not False:
+                errors += [r for r in reasons if "changed type" in r]  # a mere change is no error of a rule it leaves known
                 unknown.append(key)
                 if reasons:
                     values.append((f"{key.split('.', 1)[1]} unknown because", "; ".join(reasons)))
@@ -114,10 +120,10 @@ def build(spec: CheckedSpec, rules: Dict[str, Any], active: List[int], topics: D
     if monitor.get("agents claiming one host", "none") not in ("none", ""):  # whose values are used is unclear
         level = max(level, WARN)
         msg += f" ({monitor['agents claiming one host']})"
-    held = monitor.get("held by replaced rules (until ~reset)", "")
-    if held:  # the robot is held by rules no longer in the spec: only ~reset releases them
+    held = "; ".join(monitor[k] for k in HELD if monitor.get(k))
+    if held:  # held by nothing the rules now say (a reload, a clock jump, a restart): only ~reset releases it
         level = max(level, WARN)
-        msg += f" (HOLDING until ~reset, for rules a reload replaced: {held})"
+        msg += f" (HOLDING until ~reset: {held})"
     if monitor.get("last reload error"):
         msg += " (the last reload was rejected; the previous rules still run)"
     if failing:

@@ -218,10 +218,11 @@ class Engine:
 
     def _store_message(self, topic: str, now: float, msg: Any, changed: Set[Any]) -> None:
         store = self.store
-        if msg is UNREADABLE:  # not data: a dead sensor beside a publisher of another type still goes stale
-            msg = UNKNOWN
-        else:
+        data = msg is not UNREADABLE  # not data: a dead sensor beside a publisher of another type goes stale
+        if data:
             store.arrive(topic, now)
+        else:
+            msg = UNKNOWN
         fields = store.fields
         for number, slot, cell, path, key in self._reads.get(topic, ()):
             value = self._read(topic, path, msg, key)
@@ -231,13 +232,13 @@ class Engine:
                 cell[0] = fields[slot] = value
         for path in self._rate_paths.get(topic, ()):  # read above, as a plain field
             store.arrive_rate(topic, path, now, store.fields.get((topic, path), UNKNOWN))
-        if topic in self._stamped:
+        if topic in self._stamped and data:  # stamp_age goes on from the last readable stamp
             try:
                 stamp = UNKNOWN if msg is UNKNOWN else stamp_seconds(extract(msg, STAMP, raw=True))
             except FieldError:
                 stamp = UNKNOWN  # a type with no header.stamp: stamp_age is unknown (§11)
             store.stamps[topic] = stamp
-        if topic in self._laser:
+        if topic in self._laser and data:
             store.laser_limits[topic] = laser_limits(msg)
 
     def _read(self, topic: str, path: Tuple[ast.PathElem, ...], msg: Any, key: str) -> Any:

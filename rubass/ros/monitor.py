@@ -418,11 +418,11 @@ class Monitor(Reloading):
         if loop.dropped_by_topic:
             monitor["dropped by topic"] = ", ".join(f"{t} {n}" for t, n in sorted(loop.dropped_by_topic.items()))
         monitor["last start"] = getattr(self.dispatcher, "last_start", "none")  # with its witnesses
-        orphans = list(self.dispatcher.orphans)  # latched behaviours of a spec a reload replaced
+        orphans = list(self.dispatcher.orphans)  # latched behaviours carried over a reload or a clock jump
         if orphans:
-            monitor["held by replaced rules (until ~reset)"] = "; ".join(
-                f"{', '.join(a.name for a in b.actions)} ({b.label}, line {b.span.line}, of a replaced spec)"
-                for b, _ in orphans)
+            monitor[status_mod.HELD[0]] = "; ".join(
+                f"{', '.join(a.name for a in b.actions)} ({b.label}, line {b.span.line}, latched before the "
+                f"reload or clock jump)" for b, _ in orphans)
         monitor["data errors"] = "; ".join(data_errors) or "none"
         monitor["spec errors against the live types"] = "; ".join(e.splitlines()[0] for e in self.livecheck.errors) \
             or "none"

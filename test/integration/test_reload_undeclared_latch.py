@@ -24,7 +24,7 @@ def test_a_spec_that_stops_declaring_a_latched_active_action_reloads_and_the_sto
     rec = ros.probe({"listen": [{"topic": "/diagnostics", "type": "diagnostic_msgs/DiagnosticArray"}],
                      "steps": [{"sleep": 2.5}]})
     mon = [s for r in rec if r["kind"] == "recv" for s in r["msg"]["status"] if s["name"] == "rubass: monitor"]
-    assert mon and mon[-1]["level"] >= 1 and "HOLDING until ~reset, for rules a reload replaced: stop" in \
+    assert mon and mon[-1]["level"] >= 1 and "HOLDING until ~reset: stop (behaviour 1" in \
         mon[-1]["message"], mon[-1:]  # the robot is held: /diagnostics says by what (it said OK, none active)
     out = ros.call("/rubass/reset")
     assert "released 1 latched behaviour" in out.stdout, out.stdout

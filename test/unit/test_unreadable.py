@@ -45,3 +45,37 @@ def test_a_readable_message_is_data_again(write):
     engine.on_message("/scan", 0.5, {"data": 3.0})
     engine.advance(0.9)
     assert engine.rule_value("laser.stale") is False  # 0.4 s after the readable one at 0.5
+
+
+def test_unreadable_messages_leave_stamp_age_counting(write):
+    """Review: the stamp was set unknown by an unreadable message, so a stamp_age guard never tripped."""
+    spec = check_text("action primitive stop;\nentity laser { rules: near: topic /scan.range_min < 0.5; "
+                      "stale: stamp_age(topic /scan) > 0.5 s; }\nif (laser.near or laser.stale) then { stop; }\n",
+                      "s.rbs", [write("lib.yaml", LIB)])
+    engine = Engine(spec, 0.0)
+    engine.evaluate_all(0.0)
+    engine.on_message("/scan", 0.1, _Scan(0.1, 3.0))
+    events = []
+    for i in range(1, 10):
+        events += engine.on_message("/scan", 0.1 + 0.1 * i, UNREADABLE)
+    events += engine.advance(3.0)
+    assert [e for e in events if e.rule == "laser.stale" and e.value is True], events
+    assert [e for e in events if e.kind == "start"]
+
+
+class _Stamp:
+    def __init__(self, t):
+        self.t = t
+
+    def to_sec(self):
+        return self.t
+
+
+class _Header:
+    def __init__(self, t):
+        self.stamp = _Stamp(t)
+
+
+class _Scan:
+    def __init__(self, t, range_min):
+        self.header, self.range_min = _Header(t), range_min
