@@ -51,7 +51,7 @@ def case(master, tmp, topics, rules, seconds):
         if mon is not None:
             stop_processes([mon])
     log = open(os.path.join(tmp, "monitor.log")).read()
-    m = re.search(r"stopped after (\d+) messages \((\d+) dropped", log)
+    m = re.search(r"stopped after (\d+) messages? \((\d+) dropped", log)
     lat = r["latencies"]
     p = _common.percentile
     return {

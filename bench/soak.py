@@ -66,7 +66,7 @@ def main():
             stop_processes(load + [p for p in [mon] if p is not None])
             master.stop()
         log = open(os.path.join(tmp, "monitor.log")).read()
-    m = re.search(r"stopped after (\d+) messages \((\d+) dropped", log)
+    m = re.search(r"stopped after (\d+) messages? \((\d+) dropped", log)
     warm = next(rss for t, rss in samples if t >= args.seconds / 10)
     lat = result.get("latencies", [])
     print(json.dumps({

@@ -466,9 +466,8 @@ class Monitor(Reloading):
         self.sampler.stop()
         self.livecheck.close()
         received = sum(st.messages for st in self.watcher.status())
-        dropped = f"{loop.dropped} dropped because the engine's queue was full" if loop.dropped else "none dropped"
-        rospy.loginfo("rubass: stopped after %s (%s), %s", counted(received, "message"), dropped,
-                      counted(self.reloads, "reload"))
+        rospy.loginfo("rubass: stopped after %s (%d dropped because the engine's queue was full), %s",
+                      counted(received, "message"), loop.dropped, counted(self.reloads, "reload"))  # bench/ reads it
         # the releases are handed to the actions' threads; what follows unregisters from rospy, which
         # may wait for good for a master that does not answer (a registration holds its lock)
         exit_within(EXIT_GRACE + 1.0 * len(self.runners))
