@@ -140,11 +140,12 @@ def wait_log(proc, ros, text, timeout=10.0):
     raise AssertionError(f"'{text}' never logged:\n{ros.log(proc)}")
 
 
-def brake_after(ros, value, wait=1.0):
-    """Publish /cmd_vel linear.x = value; the /brake messages that follow within `wait`."""
+def brake_after(ros, value, wait=1.0, grace=0.0):
+    """Publish /cmd_vel linear.x = value; the /brake messages that follow within `wait`, from `grace`
+    seconds after it (a brake that was on may send one more message, already under way, as it ends)."""
     rec = ros.probe({"listen": [{"topic": "/brake", "type": "std_msgs/Bool"}],
                      "advertise": [{"topic": "/cmd_vel", "type": TWIST}],
                      "steps": [{"wait_subscribers": "/cmd_vel"}, {"sleep": 0.3}, {"mark": "go"},
                                {"publish": "/cmd_vel", "msg": {"linear": {"x": value}}}, {"sleep": wait}]})
     go = next(r["wall"] for r in rec if r["kind"] == "mark")
-    return [r for r in rec if r["kind"] == "recv" and r["wall"] > go and r["msg"]["data"] is True]
+    return [r for r in rec if r["kind"] == "recv" and r["wall"] > go + grace and r["msg"]["data"] is True]
