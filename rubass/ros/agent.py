@@ -273,7 +273,7 @@ def main(argv: Optional[List[str]] = None) -> int:
     if wants_help(argv):
         sys.stdout.write(USAGE)
         return 0
-    code = init_node(default_name(), argv, False, lambda text: sys.stderr.write(f"rubass agent: {text}\n"))
+    code = init_node(default_name(), argv, lambda text: sys.stderr.write(f"rubass agent: {text}\n"))
     if code is not None:
         return code
     stop = threading.Event()

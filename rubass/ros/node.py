@@ -28,7 +28,7 @@ def main(argv: Optional[List[str]] = None) -> int:
     # SIGHUP reloads once the monitor runs (its handler replaces this one); before, its default would end it
     signal.signal(signal.SIGHUP, lambda signum, frame: sys.stderr.write(
         "rubass: SIGHUP before the monitor started: nothing to reload yet (the spec is read when it starts)\n"))
-    code = init_node("rubass", argv, False, lambda text: sys.stderr.write(f"rubass: {text}\n"))
+    code = init_node("rubass", argv, lambda text: sys.stderr.write(f"rubass: {text}\n"))
     if code is not None:
         return code  # Monitor handles SIGINT/SIGTERM once it runs; before, a signal ends the wait for the master
     keep_rosout_flag()  # no log call asks the master anything (one would block while its host is cut off)

@@ -24,10 +24,9 @@ def wants_help(argv: Optional[List[str]]) -> bool:
     return any(a in ("-h", "--help", "help") for a in args if ":=" not in a)
 
 
-def init_node(name: str, argv: Optional[List[str]], rospy_signals: bool, say: Callable[[str], None]) -> Optional[int]:
+def init_node(name: str, argv: Optional[List[str]], say: Callable[[str], None]) -> Optional[int]:
     """rospy.init_node, after waiting for the master as long as it does not answer. None once the node
-    is up (with rospy's own SIGINT/SIGTERM handlers if `rospy_signals`, else none: the node installs
-    its own); else the exit code, after `say` has told why: 0 when SIGINT or SIGTERM ended the wait,
+    is up (without rospy's SIGINT/SIGTERM handlers: the node installs its own); else the exit code, after `say` has told why: 0 when SIGINT or SIGTERM ended the wait,
     1 when the master went away during the start. rospy is then shut down, and the process exits within
     STOP_GRACE seconds even if rospy's shutdown waits for the master."""
     import rosgraph
@@ -58,8 +57,6 @@ def init_node(name: str, argv: Optional[List[str]], rospy_signals: bool, say: Ca
         for s, handler in previous.items():
             signal.signal(s, handler)
     if not (stopped or failed or rospy.is_shutdown()):
-        if rospy_signals:
-            rospy.core.register_signals()
         return None
     say(failed or f"stopped before the ROS master at {uri} answered; nothing was started")
     code = 1 if failed else 0
