@@ -25,9 +25,11 @@ from ...actions.status import RESOLVED
 from .publish import ros_class
 
 LOG_EVERY = 5.0
-# the latest well-typed command on each input (resolved name): what came is a fact about the
-# topic, so a limit that a reload has just rebuilt starts from it, not from zero
-_LATEST: Dict[str, Tuple[bytes, float]] = {}
+# the latest well-typed command on each input, by (resolved name, message type): what came is a
+# fact about the topic, so a limit that a reload has just rebuilt starts from it, not from zero. Keyed
+# by type too: a Twist limit must never read the TwistStamped a limit of another type took from the
+# same input (its bytes read as a Twist are garbage, clamped to the maximum)
+_LATEST: Dict[Tuple[str, str], Tuple[bytes, float]] = {}
 
 
 class LimitPlugin(ActionPlugin):
@@ -67,7 +69,7 @@ class LimitPlugin(ActionPlugin):
             self._fail(f"{self.params['input']} carries {got}, not {self.type} as action '{self.name}' says: "
                        f"its commands are ignored (so after {self.timeout:g} s it publishes zero)")
             return
-        _LATEST[self.input] = (raw._buff, now)
+        _LATEST[(self.input, self.type)] = (raw._buff, now)
         self._input_ok()
         with self._lock:
             if not self._on:  # decoded only if a start needs it
@@ -127,7 +129,7 @@ class LimitPlugin(ActionPlugin):
 
     def _current(self) -> Any:
         """The latest command clamped, if it came within `timeout`; else a zero command."""
-        shared = _LATEST.get(self.input)
+        shared = _LATEST.get((self.input, self.type))
         if shared is not None and shared[1] > self._raw_at:
             self._raw, self._raw_at = shared
         if self._raw is not None and time.monotonic() - self._raw_at <= self.timeout:
