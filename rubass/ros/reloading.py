@@ -15,6 +15,7 @@ from ..actions.runner import ActionRunner
 from ..engine import Engine, Event
 from ..lang import SpecError, load_spec
 from ..lang.errors import RubassError, counted
+from ..lang.libtopics import running_type_changes
 from ..lang.model import CheckedSpec
 from .gcfreeze import freeze_heap
 from .topics import ros_now
@@ -79,6 +80,7 @@ class Reloading:
                 self._check_overload_actions(spec)
                 self._check_priorities(spec)
                 self._check_library_types(spec)
+                self._check_running_types(spec)
                 t_check = time.monotonic()
                 if self.spec is not None and self.loop is None:
                     raise StartupError(f"not enforcing yet: {self._why_not()}; reload once it enforces")
@@ -156,6 +158,17 @@ class Reloading:
                           (t_check - t0) * 1000, (t_build - t_check) * 1000, (t_swap - t_build) * 1000)
             return True, (f"reloaded in {ms:.0f} ms: {counted(len(spec.rules), 'rule')}, "
                           f"{counted(len(spec.behaviours), 'behaviour')}")
+
+    def _check_running_types(self, spec: CheckedSpec) -> None:
+        """A new action must not change the type of a topic the running actions publish: rospy keeps
+        one publisher per topic in a node, and the running one is still registered while the new
+        actions are built, so their messages would go out as the old type (garbage; the stop
+        never reaches the base). Changing a topic's type needs a restart."""
+        running = [r.plugin.action for r in self.runners.values()]
+        new = sorted(spec.actions.values(), key=lambda a: (a.span.file, a.span.line, a.span.col, a.name))
+        errors = running_type_changes(running, new, rospy.resolve_name)
+        if errors:
+            raise StartupError("\n".join(d.render(spec.sources) for d in errors))
 
     def _load_stable(self) -> CheckedSpec:
         """load_spec, again if a file changed while it was read or within the last 50 ms (an
