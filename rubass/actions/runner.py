@@ -13,7 +13,7 @@ import weakref
 from typing import Any, Callable, Deque, Dict, Optional, Set, Tuple
 
 from .base import ActionPlugin, ActionStats, Context, Skipped
-from .status import RESOLVED
+from .status import NOTHING_DONE, RESOLVED
 
 Log = Callable[[str, str], None]  # (level, text)
 BACKOFF = (0.05, 0.1, 0.2, 0.5, 1.0)
@@ -23,6 +23,10 @@ STUCK_AFTER = 2.0  # a plugin call still running this long (beyond the plugin's 
 WATCH_EVERY = 0.25  # how often the watchdog looks at the calls in progress
 # the phases whose success resolves a failure of each phase; a plugin's bad input only by the plugin
 # (a good input: holds succeed at 50 Hz whatever the input); the runner's own by the next phase
+# what a failing start or release says once the opposite phase supersedes it: no longer retried, and
+# still a failure (ERROR in /diagnostics) until an attempt of the action really succeeds
+_GIVEN_UP = {"start": " (no longer retried: released before an attempt succeeded)",
+             "release": " (no longer retried: started again before an attempt succeeded)"}
 _RESOLVED_BY = {"start": ("start", "release"), "release": ("release", "start"),
                 "hold": ("hold", "start", "release"), "periodic": ("periodic",), "input": ()}
 
@@ -247,12 +251,14 @@ class ActionRunner:
                 self._periodic_if_due()
             if self._stop and attempt > 3:
                 return  # at shutdown a release is tried a few times, not forever
+        if self.stats.failing == kind and kind in _GIVEN_UP:  # superseded while failing: still shown, as it is
+            self.stats.last_error += _GIVEN_UP[kind]
 
-    def _guard(self, what: str, fn: Callable[[], None]) -> bool:
+    def _guard(self, what: str, fn: Callable[[], Any]) -> bool:
         with self._call_lock:
             self._call = (what, time.monotonic())
         try:
-            fn()
+            result: Any = fn()
         except Skipped:
             self._returned()
             return False
@@ -272,6 +278,8 @@ class ActionRunner:
             self._returned()
             raise
         self._returned()
+        if result is NOTHING_DONE:  # nothing was tried, so nothing is proved: no call, resolves nothing
+            return True
         if what != "periodic":
             self.stats.calls += 1
         self._resolve(what)

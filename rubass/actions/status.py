@@ -14,6 +14,10 @@ from ..lang.model import CheckedSpec
 OK, WARN, ERROR = 0, 1, 2  # DiagnosticStatus levels
 # an action's last error once a later attempt succeeded: kept for the record, no longer an ERROR
 RESOLVED = "resolved (a later attempt succeeded); was: "
+# what a plugin's start, hold or release returns when it did nothing this time by its configuration (a
+# service not called in that phase, a release with no `on_release`): a success that resolves no failure,
+# so that a failed start is not shown fixed by a release that proved nothing
+NOTHING_DONE = "nothing done"
 # node references: NodeRef (version 1), NodeStat (alive/cpu/memory in version 2 of the language)
 _NODE_REFS = tuple(getattr(ast, n) for n in ("NodeRef", "NodeStat") if hasattr(ast, n))
 

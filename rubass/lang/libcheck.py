@@ -129,11 +129,40 @@ def _primitive_problem(ftype: str, v: Any) -> Optional[str]:
     if ftype == "string":
         return None if isinstance(v, str) else "give a string (quote it)"
     if ftype in _FLOATS:
+        if isinstance(v, float) and v != v:  # .nan: a stop command of NaN is no command a base can follow
+            return "a command must be a number (NaN is not one)"
         return None if isinstance(v, (int, float)) and not isinstance(v, bool) else "give a number"
     lo, hi = INTEGERS[ftype]
     if isinstance(v, bool) or not isinstance(v, int):
         return f"give a whole number from {lo} to {hi}"
     return None if lo <= v <= hi else f"the value must be from {lo} to {hi}"
+
+
+SERIAL_TEXT = ("on_start", "on_hold", "on_release")
+
+
+def serial_text_problem(text: str) -> Optional[str]:
+    """Why a serial action's text cannot be sent as it is written (None when it can): it goes out as
+    Latin-1, one byte per character, so a character above U+00FF has no byte."""
+    bad = next((c for c in text if ord(c) > 0xFF), None)
+    if bad is None:
+        return None
+    return (f"{bad!r} (U+{ord(bad):04X}) cannot be sent: serial text is sent as Latin-1, one byte per "
+            f"character (\\x00 to \\xff); write the bytes the board expects as \\xNN escapes")
+
+
+def _serial_text(act: ActionDef, sources: SourceSet) -> List[Diagnostic]:
+    """Errors at the YAML value of each on_start/on_hold/on_release that has a character with no byte."""
+    out: List[Diagnostic] = []
+    nodes = _action_nodes(sources, act)
+    for key in SERIAL_TEXT:
+        text = act.params.get(key)
+        problem = serial_text_problem(text) if isinstance(text, str) else None
+        if problem:
+            node = nodes.get(key, (None, None))[1]
+            span = _span(node, act.span.file) if node is not None else act.key_spans.get(key, act.span)
+            out.append(Diagnostic(span, f"action '{act.name}': '{key}': {problem}"))
+    return out
 
 
 def check_library_types(actions: Dict[str, ActionDef], sources: SourceSet, registry: Registry,
@@ -146,6 +175,8 @@ def check_library_types(actions: Dict[str, ActionDef], sources: SourceSet, regis
     diags: List[Diagnostic] = []
     known, known_services = list(known), list(known_services)
     for act in sorted(actions.values(), key=lambda a: (a.span.file, a.span.line)):
+        if act.plugin == "serial":
+            diags.extend(_serial_text(act, sources))
         if act.plugin not in ("publish", "service"):
             continue
         nodes = _action_nodes(sources, act)

@@ -21,7 +21,7 @@ import rospy
 from ...actions.clamp import AXES, clamp_twist
 from .arbiter import take_seat
 from ...actions.base import ActionPlugin, Context
-from ...actions.status import RESOLVED
+from ...actions.status import NOTHING_DONE, RESOLVED
 from .publish import ros_class
 
 LOG_EVERY = 5.0
@@ -106,10 +106,11 @@ class LimitPlugin(ActionPlugin):
                 self._publish(self._current())
                 self._due = False
 
-    def release(self, ctx: Context) -> None:
+    def release(self, ctx: Context) -> Any:
         with self._lock:
             self._on = False
             self.seat.deactivate()
+        return NOTHING_DONE  # it stops publishing: no I/O that proves a failed start fixed
 
     def close(self) -> None:
         with self._lock:  # a command being published finishes first; none is published after

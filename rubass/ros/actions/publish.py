@@ -10,6 +10,7 @@ import rospy
 
 from .arbiter import take_seat
 from ...actions.base import ActionPlugin, ActionSetupError, Context
+from ...actions.status import NOTHING_DONE
 
 
 def ros_class(lookup: Any, type_name: str, where: str, kind: str) -> Any:
@@ -35,6 +36,21 @@ def build_message(cls: Any, fields: Dict[str, Any], where: str) -> Any:
     return msg
 
 
+def stamps_itself(cls: Any, fields: Any) -> bool:
+    """Whether each publication of this message gets the current ROS time in `header.stamp`: its type
+    has a top-level std_msgs/Header `header` and the library's fields do not set its stamp."""
+    slots, types = list(getattr(cls, "__slots__", ())), list(getattr(cls, "_slot_types", ()))
+    if "header" not in slots or len(types) != len(slots) or types[slots.index("header")] not in (
+            "std_msgs/Header", "Header"):
+        return False
+    if fields is None:
+        return True
+    if not isinstance(fields, dict):  # positional values: the library gave the header itself
+        return False
+    header = fields.get("header")
+    return header is None or (isinstance(header, dict) and "stamp" not in header)
+
+
 class _Sink:
     def write(self, data: bytes) -> None:
         pass
@@ -52,6 +68,8 @@ class PublishPlugin(ActionPlugin):
         self.msg = build_message(cls, self.params.get("message") or {}, f"action '{self.name}': message")
         release = self.params.get("on_release")
         self.release_msg = None if release is None else build_message(cls, release, f"action '{self.name}': on_release")
+        self.stamp = stamps_itself(cls, self.params.get("message") or {})
+        self.release_stamp = release is not None and stamps_itself(cls, release)
         # Created at start-up, so that subscribers are connected before the first violation.
         # Synchronous (queue_size None): the message is written from this action's runner thread
         # rather than handed to one more rospy thread, which saves a thread hand-off (~40 µs at
@@ -62,17 +80,19 @@ class PublishPlugin(ActionPlugin):
         # among the actions on this topic only the highest-priority active one publishes (§16)
         self.seat = take_seat(self.params["topic"], self.name, self.action.priority, lambda: self.wake())
 
-    def _publish(self, msg: Any) -> bool:
-        """Publish if this action owns its topic; whether it did."""
+    def _publish(self, msg: Any, stamp: bool = False) -> bool:
+        """Publish if this action owns its topic (stamped now if `stamp`); whether it did."""
         with self.seat.turn() as mine:
             if mine and self.pub is not None:
+                if stamp:  # a stop stamped 0 is dropped as stale by a node that checks its age
+                    msg.header.stamp = rospy.get_rostime()
                 self.pub.publish(msg)
             return mine and self.pub is not None
 
     def start(self, ctx: Context) -> None:
         assert self.pub is not None
         self.seat.activate()
-        if self._publish(self.msg) and self.pub.get_num_connections() == 0:
+        if self._publish(self.msg, self.stamp) and self.pub.get_num_connections() == 0:
             # not an error rospy would report: the message just went nowhere. A failure, so it is
             # logged, counted in /diagnostics and retried (0.05 s, 0.1 s, … then every 1 s); the
             # periodic publication also reaches a subscriber that connects later.
@@ -81,12 +101,14 @@ class PublishPlugin(ActionPlugin):
 
     def periodic(self) -> None:
         if self.active and self.pub is not None:
-            self._publish(self.msg)
+            self._publish(self.msg, self.stamp)
 
-    def release(self, ctx: Context) -> None:
+    def release(self, ctx: Context) -> Any:
         try:
             if self.release_msg is not None and self.pub is not None:
-                self._publish(self.release_msg)
+                self._publish(self.release_msg, self.release_stamp)
+                return None
+            return NOTHING_DONE  # nothing published: a failed start is not shown fixed by it
         finally:
             self.seat.deactivate()  # after on_release: the next action on the topic is woken to publish
 

@@ -10,13 +10,15 @@ from typing import Any, Optional
 import rospy
 import serial
 
-from ...actions.base import ActionPlugin, Context, Skipped
+from ...actions.base import ActionPlugin, ActionSetupError, Context, Skipped
+from ...actions.status import NOTHING_DONE
+from ...lang.libcheck import SERIAL_TEXT, serial_text_problem
 
 REOPEN_PERIOD = 0.5
 
 
 def _bytes(text: Optional[str]) -> Optional[bytes]:
-    return None if text is None else text.encode("latin-1", errors="replace")
+    return None if text is None else text.encode("latin-1")  # checked at set-up: every character is a byte
 
 
 class SerialPlugin(ActionPlugin):
@@ -32,6 +34,11 @@ class SerialPlugin(ActionPlugin):
         self.call_timeout = 2 * float(self.params.get("write_timeout") or 0.0)  # write, flush: the runner's stuck bound
 
     def setup(self) -> None:
+        for key in SERIAL_TEXT:  # `rubass check` reports it at its place; a library loaded without it, here
+            text = self.params.get(key)
+            problem = serial_text_problem(text) if isinstance(text, str) else None
+            if problem:
+                raise ActionSetupError(f"action '{self.name}': '{key}': {problem}")
         self._open()  # a board that is not there yet is not fatal: periodic() keeps trying
 
     def _open(self) -> bool:
@@ -48,10 +55,11 @@ class SerialPlugin(ActionPlugin):
             self.open_failed = True
             return False
 
-    def _write(self, data: Optional[bytes]) -> None:
-        """Write now, opening the port if it is closed (a start or release, retried by the runner)."""
+    def _write(self, data: Optional[bytes]) -> Any:
+        """Write now, opening the port if it is closed (a start or release, retried by the runner);
+        NOTHING_DONE when there is nothing to write."""
         if not data:
-            return
+            return NOTHING_DONE
         with self.lock:
             if self.port is None and not self._open():
                 raise IOError(self.state)
@@ -73,11 +81,12 @@ class SerialPlugin(ActionPlugin):
         self.started = False
         self.state = why
 
-    def start(self, ctx: Context) -> None:
+    def start(self, ctx: Context) -> Any:
         if self.started:  # periodic() wrote it already when the port came back: once, not twice
-            return
-        self._write(_bytes(self.params.get("on_start")))
+            return None
+        done = self._write(_bytes(self.params.get("on_start")))
         self.started = self.port is not None
+        return done
 
     def hold(self, ctx: Context) -> None:
         """A hold (every tick) reopens a vanished port once, at once (a glitch: the board is back before
@@ -89,9 +98,9 @@ class SerialPlugin(ActionPlugin):
         self._catch_up()  # a hold may reopen the port before periodic() does: the start first
         self._write(_bytes(self.params.get("on_hold")))
 
-    def release(self, ctx: Context) -> None:
+    def release(self, ctx: Context) -> Any:
         self.started = False
-        self._write(_bytes(self.params.get("on_release")))
+        return self._write(_bytes(self.params.get("on_release")))
 
     def periodic(self) -> None:
         """Reopen a vanished device; while the action is active, write its start again to it."""
