@@ -55,11 +55,14 @@ def own_topic(a: "ActionDef", resolve: Callable[[str], str] = resolve_topic) -> 
     if keys is None:
         return None
     for key in (keys[0], "input") if a.plugin == "limit" else (keys[0],):
-        topic = resolve(str(a.params[key]))
+        written = str(a.params[key])
+        topic = resolve(written)
         if topic not in own:
             continue
         name, what = own[topic]
         spelt = f" ({name})" if name != topic else ""
+        if written.startswith("~"):  # said as written: `rubass check` does not know the monitor's name
+            topic, spelt = written, ""
         doing = f"reads its input from {topic}" if key == "input" else f"publishes {_type(a)} on {topic}"
         return Diagnostic(key_span(a, key), f"action '{a.name}': {doing}, the monitor's own topic{spelt}: "
                                             f"{what}; an action must not use the monitor's topics "

@@ -26,8 +26,8 @@ def limit(name, source, topic, extra=""):
 
 # -- 2. the monitor's own topics ---------------------------------------------------------------------
 @pytest.mark.parametrize("topic,resolved", [
-    ("~heartbeat", "/rubass/heartbeat"), ("/rubass/heartbeat", "/rubass/heartbeat"), ("~events", "/rubass/events"),
-    ("~node_samples", "/rubass/node_samples"), ("/diagnostics", "/diagnostics"), ("diagnostics", "/diagnostics"),
+    ("~heartbeat", "~heartbeat"), ("/rubass/heartbeat", "/rubass/heartbeat"), ("~events", "~events"),
+    ("~node_samples", "~node_samples"), ("rubass/events/", "/rubass/events"), ("/diagnostics", "/diagnostics"), ("diagnostics", "/diagnostics"),
     ("/rosout", "/rosout"), ("/rubass/agent_samples", "/rubass/agent_samples")])
 def test_publishing_on_a_monitor_topic_is_an_error_at_its_topic(topic, resolved):
     actions, diags = lib("actions:\n" + pub("hbx", topic, extra="    message: {data: x}\n"))
@@ -50,7 +50,7 @@ def test_a_limit_on_a_monitor_topic_is_an_error_output_and_input():
     _, diags = lib("actions:\n" + limit("a", "/nav", "/diagnostics") + limit("b", "~events", "/safe_b"))
     assert [(d[0], d[2].split(",")[0]) for d in diags] == [
         (5, "action 'a': publishes geometry_msgs/Twist on /diagnostics"),
-        (9, "action 'b': reads its input from /rubass/events")]
+        (9, "action 'b': reads its input from ~events")]
 
 
 def test_own_topics_resolve_under_the_monitors_node_name():
