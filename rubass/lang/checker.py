@@ -14,6 +14,7 @@ from . import ast
 from .errors import Diagnostic, a_noun, did_you_mean
 from .fieldmodel import FieldModel
 from .fmt import format_expr
+from .libcheck import argument_problem
 from .library import ActionDef, load_library
 from .attributes import AttrChecker
 from .deporder import dependency_order
@@ -313,6 +314,9 @@ class _Checker:
                     else:
                         self.error(a.span, "an action argument must be a literal or a constant")
                 if name in library:
+                    wrong = argument_problem(library[name], len(call.args), call.span)
+                    if wrong is not None:  # `crawl(0.05 m/s)` would still clamp as its library says
+                        self.diags.append(wrong)
                     bound.append(BoundAction(name, library[name], tuple(args), call.span))
             if not d.actions:
                 self.warnings.append(Diagnostic(d.span, "this behaviour has no actions", "warning"))

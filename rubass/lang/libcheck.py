@@ -245,3 +245,19 @@ def check_publish_topics(actions: Dict[str, ActionDef], sources: SourceSet, topi
                         + (f"; set 'type: {have}'" if have in TWIST_TYPES else ""))
             diags.append(Diagnostic(span, f"action '{act.name}': {text}"))
     return diags
+
+
+# Built-in plugins whose phases read a call's arguments (Context.args): a log action's text. A
+# custom plugin gets them as ctx.args; every other built-in plugin ignores them.
+ARGUMENT_PLUGINS = ("log",)
+
+
+def argument_problem(action: ActionDef, nargs: int, span: Span) -> Optional[Diagnostic]:
+    """An error for a call with arguments (`crawl(0.05 m/s);`) of an action whose plugin ignores
+    them: the robot would do what the library says, not what the call seems to ask."""
+    if not nargs or action.is_custom or action.plugin in ARGUMENT_PLUGINS:
+        return None
+    return Diagnostic(span, f"action '{action.name}' takes no arguments: its plugin '{action.plugin}' ignores them "
+                            f"(it does what its library entry says, {action.span}); only log actions (the text of "
+                            f"their line) and custom plugins (ctx.args) use arguments: write '{action.name};', or "
+                            f"change the library")
