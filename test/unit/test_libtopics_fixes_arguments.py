@@ -67,3 +67,18 @@ def test_no_arguments_no_problem():
     a = ActionDef("stop", "publish", {"topic": "/s", "type": "std_msgs/Empty"})
     assert argument_problem(a, 0, Span("s.rbs", 1, 1)) is None
     assert argument_problem(a, 2, Span("s.rbs", 1, 1)).span == Span("s.rbs", 1, 1)
+
+
+def test_the_docs_quote_the_error_as_it_is(tmp_path):
+    import os
+
+    from conftest import ROOT
+
+    text = open(os.path.join(ROOT, "docs", "actions.md"), encoding="utf-8").read()
+    (tmp_path / "lib.yaml").write_text(LIB)
+    (tmp_path / "safety.rbs").write_text(HEAD + "if (e.r) then { crawl(0.05 m/s); }\n")
+    with pytest.raises(SpecError) as exc:
+        load_spec(str(tmp_path / "safety.rbs"))
+    d = exc.value.diagnostics[0]
+    line = f"{d.span}: error: {d.message}".replace(f"{tmp_path}/", "")
+    assert line + "\n" in text

@@ -139,3 +139,15 @@ def test_same_types_new_topics_and_spellings():
     assert running_type_changes(old.values(), moved.values()) == []
     assert [d.subject for d in running_type_changes(old.values(), respelt.values())] == ["stop"]
     assert running_type_changes([], respelt.values()) == []  # nothing published yet: any type
+
+
+def test_the_docs_quote_the_error_as_it_is():
+    import os
+
+    from conftest import ROOT
+
+    text = open(os.path.join(ROOT, "docs", "actions.md"), encoding="utf-8").read()
+    _, diags = parse_library(Source("lib.yaml", "actions:\n  stop: {plugin: publish, topic: /safe, type: geometry_msgs/Twist}\n"
+                                    '  hbx: {plugin: publish, topic: ~heartbeat, type: std_msgs/String, message: {data: "x"}}\n'))
+    assert len(diags) == 1
+    assert f"{diags[0].span}: error: {diags[0].message}\n" in text
