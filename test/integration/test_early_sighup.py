@@ -1,0 +1,68 @@
+"""A SIGHUP in the monitor's (or an agent's) first moments, before the node's own handler is installed
+(~0.15-0.3 s of imports), no longer ends it (it did, exit 129, nothing logged): the scripts ignore
+SIGHUP from their first line. The test waits only until the kernel shows SIGHUP ignored (its
+`SigIgn` mask in /proc), which without the fix never happens, then sends SIGHUPs while the process
+is still importing, and checks that it lives on and still stops cleanly on SIGTERM."""
+import os
+import signal
+import socket
+import subprocess
+import sys
+import time
+
+import pytest
+
+from conftest import ROOT
+
+pytestmark = pytest.mark.ros  # the scripts import rospy
+
+
+def _ignores_sighup(pid: int) -> bool:
+    try:
+        with open(f"/proc/{pid}/status") as f:
+            for line in f:
+                if line.startswith("SigIgn:"):
+                    return bool(int(line.split()[1], 16) & (1 << (signal.SIGHUP - 1)))
+    except OSError:
+        pass
+    return False
+
+
+def _env(tmp_path):
+    with socket.socket() as s:  # no master answers there: the node waits for it, importing nothing more
+        s.bind(("127.0.0.1", 0))
+        uri = f"http://127.0.0.1:{s.getsockname()[1]}"
+    return dict(os.environ, ROS_MASTER_URI=uri, ROS_IP="127.0.0.1", ROS_HOME=str(tmp_path),
+                PYTHONDONTWRITEBYTECODE="1")
+
+
+@pytest.mark.parametrize("script", ["monitor", "agent"])
+def test_a_sighup_right_after_start_does_not_end_the_process(tmp_path, script):
+    param = "_spec:=/nonexistent.rbs" if script == "monitor" else "_node_rate:=5"
+    started = time.monotonic()
+    proc = subprocess.Popen([sys.executable, os.path.join(ROOT, "scripts", script), param], env=_env(tmp_path),
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, start_new_session=True)
+    try:
+        end = time.monotonic() + 10.0
+        while not _ignores_sighup(proc.pid) and proc.poll() is None and time.monotonic() < end:
+            time.sleep(0.001)
+        ignored_after = time.monotonic() - started
+        assert _ignores_sighup(proc.pid), f"SIGHUP is not ignored at the start of scripts/{script}"
+        for _ in range(10):  # during the imports (the first is sent at once)
+            proc.send_signal(signal.SIGHUP)
+            time.sleep(0.03)
+        lines = [proc.stderr.readline() for _ in range(1)]  # once it runs: it waits for the master
+        while "waiting for the ROS master" not in lines[-1] and lines[-1] and len(lines) < 20:
+            lines.append(proc.stderr.readline())  # (the monitor may first say a SIGHUP came too early)
+        assert "waiting for the ROS master" in lines[-1], (lines, proc.poll(), ignored_after)
+        proc.send_signal(signal.SIGHUP)
+        time.sleep(0.2)
+        assert proc.poll() is None, f"ended by a SIGHUP: exit {proc.returncode}"
+        proc.send_signal(signal.SIGTERM)
+        out, err = proc.communicate(timeout=15)
+        assert proc.returncode != -signal.SIGHUP and proc.returncode != 128 + signal.SIGHUP, (proc.returncode, err)
+        assert "Traceback" not in err, err
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.wait()
