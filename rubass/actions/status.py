@@ -149,3 +149,14 @@ def not_enforcing(spec_path: str, error: str, reloads: int, rejected: int) -> Li
     return [Entry("rubass: monitor", ERROR, f"NOT ENFORCING ANY RULE: {first}",
                   [("spec", spec_path), ("error", error), ("reloads", str(reloads)),
                    ("rejected reloads", str(rejected)), ("heartbeat", "not published until a usable spec is loaded")])]
+
+
+def waiting_for_clock(spec_path: str, waited: float, held: Sequence[str] = ()) -> List[Entry]:
+    """The monitor's only status while use_sim_time is true and no /clock message has come: ERROR
+    (ROS time is 0, nothing is watched or enforced; a use_sim_time left set on a real robot looks so)."""
+    return [Entry("rubass: monitor", ERROR,
+                  f"NOT ENFORCING ANY RULE: use_sim_time is true and no /clock message has come for {waited:.1f} s: "
+                  f"waiting for the first one (no rule is evaluated until then; is /use_sim_time left set?)",
+                  [("spec", spec_path), ("use_sim_time", "true"), ("waiting for /clock", f"{waited:.1f} s"),
+                   ("heartbeat", "not published until the first /clock message"),
+                   ("latched at start (until ~reset)", "; ".join(held) or "none")])]

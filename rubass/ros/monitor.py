@@ -205,8 +205,19 @@ class Monitor(Reloading):
         now = _ros_now()
         if now == 0.0 and rospy.get_param("/use_sim_time", False):
             rospy.logwarn("rubass: use_sim_time is set and no /clock message has come yet: waiting for the "
-                          "first one before watching (no ~heartbeat meanwhile; latched actions are held)")
+                          "first one before watching (no rule is enforced and no ~heartbeat is published "
+                          "meanwhile; latched actions are held)")
+            started = time.monotonic()
+            due = started  # /diagnostics says so meanwhile, on the wall clock (ROS time stands at 0)
             while now == 0.0 and not self._exit.is_set() and not rospy.is_shutdown():
+                if time.monotonic() >= due:
+                    due += 1.0 / self.config.diagnostics_rate
+                    held = [f"{', '.join(r.actions)} ({r.holder})" for r in self.keeper.restored]
+                    try:
+                        self.outputs.status(status_mod.waiting_for_clock(self.config.spec, time.monotonic() - started,
+                                                                         held), time.time())
+                    except Exception as exc:  # noqa: BLE001 - the wait goes on; the log says why
+                        rospy.logerr_throttle(10, f"rubass: status failed: {exc.__class__.__name__}: {exc}")
                 self._exit.wait(0.01)
                 now = _ros_now()
             rospy.loginfo("rubass: first /clock message: %.3f s", now)
