@@ -101,6 +101,13 @@ class Reloading:
                     raise StartupError(f"{spec.path}: the new spec no longer declares {', '.join(gone)}, which is "
                                        f"latched and active, and no action library it loads defines it any more "
                                        f"(renamed or removed); call ~reset first (or keep the action's name)")
+                unlatched = [n for n, r in self.runners.items() if n in spec.actions and r.active
+                             and self.spec.actions[n].latch and not spec.actions[n].latch]
+                if unlatched:  # it would release a protective stop without ~reset (a restart keeps holding it)
+                    raise StartupError(f"{spec.path}: the new action library makes {', '.join(unlatched)} not latched "
+                                       f"(latch: false) while it is latched and active: the reload would release "
+                                       f"the stop without ~reset; call ~reset first (once its cause is gone), then "
+                                       f"reload")
                 slow = threading.Timer(1.0, lambda: rospy.logwarn(
                     "rubass: reload (%s): setting up its new actions waits for the master (a new publisher or "
                     "service registers with it); the previous rules keep running until it answers", reason))
