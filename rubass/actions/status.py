@@ -5,7 +5,7 @@ Pure: built from plain snapshots, so it is tested without ROS.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Any, Dict, List, Sequence, Tuple
+from typing import Any, Dict, List, Optional, Sequence, Tuple
 
 from ..lang import ast
 from ..lang.errors import counted
@@ -62,9 +62,11 @@ HELD = ("held over a reload or clock jump (until ~reset)", "latched at start (un
 
 def build(spec: CheckedSpec, rules: Dict[str, Any], active: List[int], topics: Dict[str, Dict[str, Any]],
           nodes: Dict[str, Dict[str, Any]], field_errors: Dict[Tuple[str, str], str],
-          monitor: Dict[str, Any], failing: Sequence[Tuple[str, str]] = ()) -> List[Entry]:
+          monitor: Dict[str, Any], failing: Sequence[Tuple[str, str]] = (),
+          computed: Optional[Dict[str, List[str]]] = None) -> List[Entry]:
     """Entries for every entity (WARN while one of its rules is true, ERROR on data errors) and the
-    monitor; `failing`: (name, error) of the actions whose latest attempt failed (ERROR meanwhile)."""
+    monitor; `failing`: (name, error) of the actions whose latest attempt failed (ERROR meanwhile);
+    `computed`: rule -> why its expression is unknown from values that came (engine/unknowns.py)."""
     out: List[Entry] = []
     by_entity: Dict[str, List[str]] = {}
     for r in spec.rules:
@@ -83,6 +85,7 @@ def build(spec: CheckedSpec, rules: Dict[str, Any], active: List[int], topics: D
             elif v is not False:
                 errors += [r for r in reasons if "changed type" in r]  # a mere change is no error of a rule it leaves known
                 unknown.append(key)
+                reasons = reasons + [r for r in (computed or {}).get(key, ()) if r not in reasons]
                 if reasons:
                     values.append((f"{key.split('.', 1)[1]} unknown because", "; ".join(reasons)))
         if errors:  # named: the rule, the field and what is wrong

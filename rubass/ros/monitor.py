@@ -46,6 +46,7 @@ from std_srvs.srv import Trigger, TriggerResponse
 
 from ..engine import Engine, Event
 from ..engine.loop import EngineLoop, Message, NodeSample
+from ..engine.unknowns import rule_reasons
 from ..lang import SpecError, load_spec
 from ..lang.errors import counted
 from ..lang.library import priority_conflicts
@@ -400,6 +401,7 @@ class Monitor(Reloading):
             return dict(engine.store.rules), engine.active_behaviours(), dict(engine.field_errors)
 
         rules, active, field_errors = loop.call(snapshot)
+        computed = loop.call(lambda engine: rule_reasons(engine.spec, engine.store))  # at the status rate only
         data_errors = loop.call(self._data_errors)
         self.livecheck.use(self.spec, self.config.actions)  # after a reload: the new spec
         self.livecheck.note(self.watcher.carried_types())
@@ -440,7 +442,7 @@ class Monitor(Reloading):
         if self.error_guard.active:
             monitor["data error actions"] = "running " + ", ".join(self.error_guard.actions)
         assert self.spec is not None
-        entries = status_mod.build(self.spec, rules, active, topics, nodes, field_errors, monitor, failing)
+        entries = status_mod.build(self.spec, rules, active, topics, nodes, field_errors, monitor, failing, computed)
         self.outputs.status(entries, _ros_now())
 
     def shutdown(self) -> None:

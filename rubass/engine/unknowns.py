@@ -1,0 +1,219 @@
+"""Why a rule is unknown although its data came: the computed causes (LANGUAGE.md §5: "the monitor
+reports every unknown in its status").
+
+Data-level causes (no message yet, a field the type lacks, a node that cannot be measured) are found
+by rubass/actions/status.py from the shell's snapshots. What this module finds is an unknown that the
+expression itself makes out of values that are there: a division by zero, NaN from arithmetic
+(inf - inf, 0 * inf), sqrt of a negative number, an index past the end of an array, min/max of an
+empty array or slice (or of one with only NaN, or no valid laser reading), a field that is NaN, a
+frequency window not yet full, a missing header stamp, a rule that is itself unknown.
+
+It walks a rule's expression with the store's current values when the status is built (about once
+a second, on the engine's thread), never per message: the evaluation closures stay as they are. It
+reads the store and writes nothing; stateful operators (`for`, `within`, `latch`) are only looked
+into, their state is theirs.
+"""
+from __future__ import annotations
+
+import math
+from typing import Any, Dict, List, Optional, Tuple
+
+from ..lang import ast
+from ..lang.fmt import format_expr, format_number
+from ..lang.model import CheckedSpec
+from ..lang.ops import BINARY, UNARY, scalar_fn
+from .arrays import array_fn
+from .store import Store
+from .values import UNKNOWN, as_num
+
+OPAQUE = object()  # a value this walk does not compute (the state of an operator, a quantifier's count)
+_ARITH = ("+", "-", "*", "/")
+
+
+def rule_reasons(spec: CheckedSpec, store: Store) -> Dict[str, List[str]]:
+    """rule key -> why it is unknown, computed from the store, for every rule whose value is neither
+    true nor false (empty lists left out)."""
+    out: Dict[str, List[str]] = {}
+    for rule in spec.rules:
+        v = store.rules.get(rule.key, UNKNOWN)
+        if v is True or v is False:
+            continue
+        try:
+            why = reasons(rule.expr, store)
+        except Exception:  # noqa: BLE001 - a bug here must never cost the status: the rule says unknown still
+            continue
+        if why:
+            out[rule.key] = why
+    return out
+
+
+def reasons(expr: ast.Expr, store: Store) -> List[str]:
+    """Why `expr` (or a part of it) is unknown with the store's values, in reading order, each once."""
+    why: List[str] = []
+    _Walk(store, why).value(expr)
+    seen: Dict[str, None] = {}
+    for w in why:
+        seen.setdefault(w, None)
+    return list(seen)
+
+
+def _text(e: ast.Expr) -> str:
+    try:
+        return format_expr(e)
+    except Exception:  # noqa: BLE001 - a construct the printer does not know: still a reason
+        return type(e).__name__
+
+
+def _num(v: Any) -> str:
+    if v is True or v is False:
+        return "true" if v else "false"
+    if isinstance(v, float):
+        return format_number(v) if math.isfinite(v) else ("inf" if v > 0 else "-inf")
+    return "unknown" if v is UNKNOWN else repr(v)
+
+
+def _is_num(v: Any) -> bool:
+    return type(v) is float and v == v
+
+
+class _Walk:
+    def __init__(self, store: Store, why: List[str]) -> None:
+        self.store, self.why = store, why
+
+    def value(self, e: ast.Expr) -> Any:
+        """e's value as the engine computes it (UNKNOWN or OPAQUE included), noting computed causes."""
+        store = self.store
+        if isinstance(e, ast.Lit):
+            return e.value
+        if isinstance(e, ast.RuleRef):
+            v = store.rules.get(e.key, UNKNOWN)
+            if v is not True and v is not False:
+                self.why.append(f"rule '{e.key}' is unknown (its own status says why)")
+            return v
+        if isinstance(e, ast.TopicRef):
+            return self._field(e)
+        if isinstance(e, ast.Unary):
+            return self._apply(e, UNARY[e.op], (e.operand,))
+        if isinstance(e, ast.Binary):
+            return self._binary(e)
+        if isinstance(e, ast.Call):
+            return self._call(e)
+        if isinstance(e, ast.ArrayFn):
+            return self._array_fn(e)
+        return self._builtin(e)
+
+    def _apply(self, e: ast.Expr, fn: Any, operands: Tuple[ast.Expr, ...]) -> Any:
+        vals = [self.value(o) for o in operands]
+        if any(v is OPAQUE for v in vals):
+            return OPAQUE
+        return fn(*vals)
+
+    def _binary(self, e: ast.Binary) -> Any:
+        left, right = self.value(e.left), self.value(e.right)
+        if left is OPAQUE or right is OPAQUE:
+            return OPAQUE
+        v = BINARY[e.op](left, right)
+        if v is UNKNOWN and e.op in _ARITH and _is_num(left) and _is_num(right):
+            if e.op == "/" and right == 0.0:
+                self.why.append(f"division by zero: {_text(e)} is {_num(left)} / {_num(right)}")
+            else:  # inf - inf, 0 * inf, inf / inf: not a number
+                self.why.append(f"not a number: {_text(e)} is {_num(left)} {e.op} {_num(right)}")
+        return v
+
+    def _call(self, e: ast.Call) -> Any:
+        vals = [self.value(a) for a in e.args]
+        if any(v is OPAQUE for v in vals):
+            return OPAQUE
+        v = scalar_fn(e.func)(*vals)
+        if v is UNKNOWN and all(_is_num(x) for x in vals):
+            if e.func == "sqrt" and vals[0] < 0:
+                self.why.append(f"sqrt of a negative number: {_text(e)} is sqrt({_num(vals[0])})")
+            else:
+                self.why.append(f"not a number: {_text(e)} of {', '.join(_num(x) for x in vals)}")
+        return v
+
+    def _field(self, e: ast.TopicRef) -> Any:
+        store = self.store
+        if not e.path:
+            return OPAQUE  # a bare topic: only its arrival matters
+        v = store.fields.get((e.topic, e.path), UNKNOWN)
+        if v is not UNKNOWN or e.topic not in store.last_arrival:
+            return v  # a value, or no message yet (the data-level reasons say so)
+        index = next((i for i, p in enumerate(e.path) if isinstance(p, int)), None)
+        if index is not None:
+            i = e.path[index]
+            array = e.topic + ast.path_suffix(e.path[:index])
+            size = self._length(e.topic, e.path[:index])
+            assert isinstance(i, int)
+            if size is not None and not -size <= i < size:
+                self.why.append(f"index out of range: {_text(e)} in an array of {size} element"
+                                f"{'' if size == 1 else 's'} ({array} in the last message)")
+            elif size is None:
+                need = i + 1 if i >= 0 else -i
+                self.why.append(f"{_text(e)}: {array} in the last message has fewer than {need} element"
+                                f"{'' if need == 1 else 's'} (index out of range), or that element is NaN")
+            else:
+                self.why.append(f"{_text(e)} is NaN in the last message")
+        else:
+            self.why.append(f"{_text(e)} is NaN (or unreadable) in the last message")
+        return v
+
+    def _length(self, topic: str, path: Tuple[ast.PathElem, ...]) -> Optional[int]:
+        """The length of the array at `path` in the last message, when the store holds it whole."""
+        for slot in ((topic, path), (topic, path + (ast.Slice(),))):
+            arr = self.store.fields.get(slot)
+            if isinstance(arr, (tuple, bytes)):
+                return len(arr)
+        return None
+
+    def _array_fn(self, e: ast.ArrayFn) -> Any:
+        store = self.store
+        arr = store.fields.get((e.ref.topic, e.ref.path), UNKNOWN)
+        laser = e.ref.path[:1] == ("ranges",) and len(e.ref.path) <= 2 and not e.elem
+        limits = (lambda: store.laser_limits.get(e.ref.topic)) if laser else None
+        v = array_fn(e.func, lambda: arr, e.elem, limits)()
+        if v is not UNKNOWN or not isinstance(arr, (tuple, bytes)):
+            return v  # a value, or no array (no message yet, a field error: the data-level reasons)
+        sliced = ast.slice_at(e.ref.path) >= 0
+        what = f"{e.ref.topic}{e.ref.path_text}"
+        if not arr:
+            full = self._length(e.ref.topic, e.ref.path[:ast.slice_at(e.ref.path)]) if sliced else None
+            self.why.append(f"{_text(e)} of an empty {'slice' if sliced else 'array'}: {what} has no element"
+                            f" in the last message" + (f" (the array has {full})" if full is not None else ""))
+        elif limits is not None and limits() is not None:
+            lo, hi = limits()  # type: ignore[misc]
+            self.why.append(f"{_text(e)}: no valid reading among the {len(arr)} of {what} (all NaN, +inf or "
+                            f"outside [range_min {_num(lo)}, range_max {_num(hi)}], REP 117)")
+        else:
+            self.why.append(f"{_text(e)}: no number among the {len(arr)} element{'' if len(arr) == 1 else 's'} "
+                            f"of {what} (all NaN)")
+        return v
+
+    def _builtin(self, e: ast.Expr) -> Any:
+        store = self.store
+        if isinstance(e, ast.Age):
+            return store.age(e.topic)
+        if isinstance(e, ast.Frequency):
+            v = store.frequency(e.topic, e.window)
+            if v is UNKNOWN and e.topic in store.watch_start:
+                self.why.append(f"{_text(e)}: {e.topic} watched for less than its "
+                                f"{format_number(e.window)} s window yet")
+            return v
+        if isinstance(e, ast.StampAge):
+            v = store.stamp_age(e.topic)
+            if v is UNKNOWN and e.topic in store.last_arrival:
+                self.why.append(f"{_text(e)}: the last message on {e.topic} has a zero header.stamp, or none")
+            return v
+        if isinstance(e, ast.NodeStat):
+            return store.node_value(e.node, e.attr)  # the data-level reasons say why a node is unknown
+        if isinstance(e, ast.Rate):
+            v = store.rates.get((e.ref.topic, e.ref.path), UNKNOWN)
+            if v is UNKNOWN and e.ref.topic in store.last_arrival:
+                self.why.append(f"{_text(e)}: needs two messages on {e.ref.topic} with a number in "
+                                f"{e.ref.path_text.lstrip('.')}, at two different times")
+            return v
+        if isinstance(e, ast.Quant):
+            return OPAQUE  # its body reads one element at a time: no single value to look into
+        for child in ast.children(e):  # for, within, latch, zones: look inside
+            self.value(child)
+        return OPAQUE
