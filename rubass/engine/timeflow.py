@@ -2,11 +2,14 @@
 
 Between inputs, only `age` and `stamp_age` change, each at one second per second, and
 `frequency` steps when a message leaves its window. So every number built from them is known
-with its slope: each such expression gets a second closure returning (value, d value / d now).
-A comparison whose sides depend on time, and each min/max/abs/sqrt kink inside them, announce
-the instant their difference reaches zero. For sums, differences, scalar multiples, min, max and
-abs of ages this instant is exact; for products or quotients of two times, sqrt and hypot it is a
-Newton step from the side that is not yet crossed, taken again at each evaluation. Time inside a
+with its first two time derivatives: each such expression gets a second closure returning
+(value, d/d now, d2/d now2). A comparison whose sides depend on time, and each min/max/abs/sqrt
+kink inside them, announce the instant their difference reaches zero. For sums, differences,
+scalar multiples, min, max and abs of ages this instant is exact, and so it is for a product of
+two times (a quadratic). For quotients, sqrt and hypot it is the earlier of the first- and
+second-order steps from the side that is not yet crossed, taken again at each evaluation (the
+first-order step is early on a concave curve, the second-order one on a convex one; at a point
+where the slope is infinite, as sqrt at 0, the next look is 1 ms later). Time inside a
 quantifier's body or a zone's point is not followed here: the engine's ticks evaluate it.
 """
 from __future__ import annotations
@@ -18,11 +21,13 @@ from ..lang import ast
 from .store import Store
 from .values import UNKNOWN
 
-Dual = Callable[[], Tuple[Any, float]]
+Dual = Callable[[], Tuple[Any, float, float]]  # (value, slope, curvature) at the store's now
 
 # Instants are set this much after the exact crossing, so that the evaluation there sees the new
 # value despite float rounding (ROS wall-clock times near 1.7e9 s have a resolution of 2.4e-7 s).
 CROSSING_MARGIN = 1e-6
+# Where a difference's slope is infinite (sqrt at 0), it is looked at again this much later.
+SINGULAR_STEP = 1e-3
 
 _COMPARE = ("<", "<=", ">", ">=", "==", "!=")
 
@@ -49,12 +54,12 @@ class Crossings:
         now = self.at = self.store.now
         best = math.inf
         for diff in self.diffs:
-            value, slope = diff()
-            if value is UNKNOWN or not slope or not math.isfinite(slope):
+            value, slope, curve = diff()
+            if value is UNKNOWN:
                 continue
-            t = now - value / slope
-            if t >= now - CROSSING_MARGIN:
-                best = min(best, max(t, now) + CROSSING_MARGIN)
+            h = step_to_zero(value, slope, curve)
+            if h is not None:
+                best = min(best, now + max(h, 0.0) + CROSSING_MARGIN)
         for topic, window in self.windows:
             change = self.store.next_frequency_change(topic, window)
             if change is not None and change + CROSSING_MARGIN > now:
@@ -72,6 +77,25 @@ class Crossings:
 
     def restore(self, state: Any) -> None:
         pass
+
+
+def step_to_zero(value: float, slope: float, curve: float) -> Optional[float]:
+    """How long until a difference of (value, slope, curvature) reaches zero, by the earlier of its
+    first- and second-order approximations (exact for a linear or quadratic one); None if neither
+    reaches it. A root up to CROSSING_MARGIN in the past counts (it is being crossed now)."""
+    if not math.isfinite(slope) or not math.isfinite(curve):
+        toward = (slope > 0) != (value > 0) if math.isinf(slope) else True
+        return SINGULAR_STEP if value != 0.0 and math.isfinite(value) and toward else None
+    steps = []
+    if slope:
+        steps.append(-value / slope)
+    if curve:
+        disc = slope * slope - 2.0 * curve * value
+        if disc >= 0.0:
+            root = math.sqrt(disc)
+            steps += [(-slope - root) / curve, (-slope + root) / curve]
+    ahead = [h for h in steps if h >= -CROSSING_MARGIN]
+    return min(ahead) if ahead else None
 
 
 def crossings(expr: ast.Expr, value_of: Callable[[ast.Expr], Callable[[], Any]], store: Store) -> Optional[Crossings]:
@@ -111,71 +135,83 @@ class _Duals:
     def difference(self, a: ast.Expr, b: ast.Expr) -> Dual:
         da, db = self.dual(a), self.dual(b)
 
-        def diff() -> Tuple[Any, float]:
-            (va, sa), (vb, sb) = da(), db()
+        def diff() -> Tuple[Any, float, float]:
+            (va, sa, ca), (vb, sb, cb) = da(), db()
             if type(va) is not float or type(vb) is not float:
-                return UNKNOWN, 0.0
-            return va - vb, sa - sb
+                return UNKNOWN, 0.0, 0.0
+            return va - vb, sa - sb, ca - cb
         return diff
 
     def dual(self, e: ast.Expr) -> Dual:
         if not time_dependent(e):
             fn = self.value_of(e)
-            return lambda: (fn(), 0.0)
+            return lambda: (fn(), 0.0, 0.0)
         if isinstance(e, (ast.Age, ast.StampAge)):
             fn = self.value_of(e)
-            return lambda: (fn(), 1.0)
+            return lambda: (fn(), 1.0, 0.0)
         if isinstance(e, ast.Unary) and e.op == "-":
             inner = self.dual(e.operand)
 
-            def neg() -> Tuple[Any, float]:
-                v, s = inner()
-                return (-v if type(v) is float else UNKNOWN), -s
+            def neg() -> Tuple[Any, float, float]:
+                v, s, c = inner()
+                return (-v if type(v) is float else UNKNOWN), -s, -c
             return neg
         if isinstance(e, ast.Binary) and e.op in "+-*/":
             return self._arith(e.op, self.dual(e.left), self.dual(e.right))
         if isinstance(e, ast.Call):
             return self._call(e.func, [self.dual(a) for a in e.args])
         fn = self.value_of(e)
-        return lambda: (fn(), 0.0)
+        return lambda: (fn(), 0.0, 0.0)
 
     @staticmethod
     def _arith(op: str, da: Dual, db: Dual) -> Dual:
-        def apply() -> Tuple[Any, float]:
-            (a, sa), (b, sb) = da(), db()
+        def apply() -> Tuple[Any, float, float]:
+            (a, sa, ca), (b, sb, cb) = da(), db()
             if type(a) is not float or type(b) is not float:
-                return UNKNOWN, 0.0
+                return UNKNOWN, 0.0, 0.0
             if op == "+":
-                return a + b, sa + sb
+                return a + b, sa + sb, ca + cb
             if op == "-":
-                return a - b, sa - sb
+                return a - b, sa - sb, ca - cb
             if op == "*":
-                return a * b, a * sb + b * sa
+                return a * b, a * sb + b * sa, ca * b + 2.0 * sa * sb + a * cb
             if b == 0:
-                return UNKNOWN, 0.0
-            return a / b, (sa * b - a * sb) / (b * b)
+                return UNKNOWN, 0.0, 0.0
+            q = a / b
+            sq = (sa - q * sb) / b
+            return q, sq, (ca - 2.0 * sq * sb - q * cb) / b
         return apply
 
     @staticmethod
     def _call(func: str, args: List[Dual]) -> Dual:
-        def apply() -> Tuple[Any, float]:
+        def apply() -> Tuple[Any, float, float]:
             vals = [a() for a in args]
-            if any(type(v) is not float for v, _ in vals):
-                return UNKNOWN, 0.0
+            if any(type(v[0]) is not float for v in vals):
+                return UNKNOWN, 0.0, 0.0
             if func in ("min", "max"):
                 pick = (min if func == "min" else max)(vals, key=lambda p: p[0])
                 return pick
-            (v, s) = vals[0]
+            (v, s, c) = vals[0]
             if func == "abs":
-                return abs(v), (s if v > 0 else -s if v < 0 else abs(s))
+                sign = 1.0 if v > 0 or (v == 0 and (s > 0 or (s == 0 and c >= 0))) else -1.0
+                return abs(v), sign * s, sign * c
             if func == "sqrt":
-                if v < 0:
-                    return UNKNOWN, 0.0
-                root = math.sqrt(v)
-                return root, (s / (2 * root) if root > 0 else math.inf)
+                return _sqrt(v, s, c)
             if func == "hypot":
-                (w, t) = vals[1]
-                h = math.hypot(v, w)
-                return h, ((v * s + w * t) / h if h > 0 else 0.0)
-            return UNKNOWN, 0.0
+                (w, t, d) = vals[1]
+                return _sqrt(v * v + w * w, 2.0 * (v * s + w * t), 2.0 * (s * s + v * c + t * t + w * d))
+            return UNKNOWN, 0.0, 0.0
         return apply
+
+
+def _sqrt(u: float, s: float, c: float) -> Tuple[Any, float, float]:
+    """sqrt of a number of (value, slope, curvature); slope infinite where u is 0 and moving."""
+    if u < 0:
+        return UNKNOWN, 0.0, 0.0
+    root = math.sqrt(u)
+    if root == 0.0:  # u ~ s h + c h^2 / 2 near here
+        if s:
+            return 0.0, math.copysign(math.inf, s), 0.0
+        return 0.0, math.sqrt(max(c, 0.0) / 2.0), 0.0
+    slope = s / (2.0 * root)
+    return root, slope, (c - 2.0 * slope * slope) / (2.0 * root)
