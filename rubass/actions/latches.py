@@ -6,7 +6,14 @@ it is started again (`respawn="true"`), until `~reset`. The file names the latch
 the behaviours holding them; it is written (atomically: a temporary file renamed over it) before
 a latched action is dispatched, and read before the first tick. A file that cannot be read as
 one of ours is reported and treated as "latched" for every action it names (for every latched
-action of the spec when it names none): the robot stays stopped rather than restarts.
+action of the spec when it names none): the robot stays stopped rather than restarts. A
+latched action the file names that the spec no longer declares (renamed or removed while the
+monitor was down) cannot be run: it is `kept` in the file until ~reset, and the monitor withholds
+its ~heartbeat meanwhile (`undeclared`; docs/failure-modes.md).
+
+The file is keyed by node name and by master (`master_key`): two monitors of one name on one
+machine, each with its own master, never share one. Its "spec" field names the spec that wrote it,
+for people: a latch is restored whatever spec the restarted monitor runs (the conservative choice).
 
 No ROS here: the path is given, the format is JSON, so it is tested without a master.
 """
@@ -17,7 +24,8 @@ import os
 import re
 import threading
 from dataclasses import dataclass
-from typing import Any, Dict, Iterable, List, Optional, Sequence, Tuple
+from typing import Any, Callable, Dict, Iterable, List, Optional, Sequence, Tuple
+from urllib.parse import urlsplit
 
 from ..lang.sourcefile import read_at_most
 
@@ -33,10 +41,37 @@ class Latch:
     actions: Tuple[str, ...]
 
 
-def default_path(ros_home: Optional[str], node_name: str) -> str:
-    """$ROS_HOME/rubass/NODE.latches.json (ROS_HOME defaults to ~/.ros, as for ROS's own logs)."""
+DEFAULT_PORT = 11311  # ROS's default master port
+
+
+def master_key(uri: str, is_local: Callable[[str], bool]) -> str:
+    """What names the master in the state file's name: "" for a master on this machine at the
+    default port (the name of version 2, so an upgrade keeps its latches), "PORT" for one on this
+    machine at another port (localhost, 127.0.0.1 and this machine's name are one master), and
+    "HOST.PORT" for a master on another machine (HOST lower-cased, as ROS_MASTER_URI spells it).
+    is_local: whether a host name or address is this machine's."""
+    parts = urlsplit(uri.strip())
+    try:
+        port = parts.port or DEFAULT_PORT
+        host = (parts.hostname or "").rstrip(".").lower()
+    except ValueError:  # no URI rospy could have used; still one file per spelling
+        return _safe(uri.strip().lower()) or "unknown-master"
+    if not host or is_local(host):
+        return "" if port == DEFAULT_PORT else str(port)
+    return f"{_safe(host)}.{port}"
+
+
+def _safe(text: str) -> str:
+    return re.sub(r"[^a-z0-9.-]", "_", text)
+
+
+def default_path(ros_home: Optional[str], node_name: str, master: str = "") -> str:
+    """$ROS_HOME/rubass/NODE.latches.json for a master on this machine at the default port, else
+    $ROS_HOME/rubass/NODE.MASTER.latches.json with MASTER from master_key (ROS_HOME defaults to
+    ~/.ros, as for ROS's own logs)."""
     home = ros_home or os.path.join(os.path.expanduser("~"), ".ros")
-    return os.path.join(home, "rubass", (node_name.strip("/").replace("/", "_") or "rubass") + ".latches.json")
+    node = node_name.strip("/").replace("/", "_") or "rubass"
+    return os.path.join(home, "rubass", node + (f".{master}" if master else "") + ".latches.json")
 
 
 def adopt_old_default(path: str, old: str) -> bool:
@@ -56,7 +91,7 @@ def load(path: str, declared: Dict[str, bool]) -> Tuple[List[Latch], List[str]]:
     """The latches a previous run left (none if there is no file) and the problems found.
 
     declared: the spec's action names -> whether each is latched. Actions the file names that
-    the spec does not declare cannot be held: they are reported.
+    the spec does not declare cannot be held: they are reported (and `undeclared` lists them).
     """
     try:
         with open(path, "rb") as fh:
@@ -65,6 +100,39 @@ def load(path: str, declared: Dict[str, bool]) -> Tuple[List[Latch], List[str]]:
         return [], []
     except OSError as exc:
         return _fallback(b"", declared, f"latch state {path} cannot be read ({exc.strerror})")
+    latches, error = _parse(raw)
+    if error:
+        return _fallback(raw, declared, f"latch state {path} is corrupt or foreign ({error})")
+    problems = []
+    out = []
+    for latch in latches:
+        known = tuple(a for a in latch.actions if a in declared)
+        unknown = [a for a in latch.actions if a not in declared]
+        if unknown:
+            problems.append(f"latch state {path}: {latch.holder} held {', '.join(unknown)}, which the spec does not "
+                            f"declare: cannot hold {'it' if len(unknown) == 1 else 'them'}")
+        if known:
+            out.append(Latch(latch.holder, known))
+    return out, problems
+
+
+def undeclared(path: str, declared: Dict[str, bool]) -> List[Latch]:
+    """The latches of a readable state file whose actions the spec does not declare (only those
+    actions): a protective stop the monitor cannot run any more. None for a missing or damaged
+    file (a damaged one is read as latching the declared actions it names: `load`)."""
+    try:
+        with open(path, "rb") as fh:
+            raw = read_at_most(fh, 1 << 20)
+    except OSError:
+        return []
+    latches, error = _parse(raw)
+    if error:
+        return []
+    return holders((latch.holder, [a for a in latch.actions if a not in declared]) for latch in latches)
+
+
+def _parse(raw: bytes) -> Tuple[List[Latch], str]:
+    """The latches of a state file's bytes, or why they are not one of ours."""
     try:
         data = json.loads(raw.decode("utf-8"))
         if not isinstance(data, dict) or data.get("format") != FORMAT:
@@ -82,18 +150,8 @@ def load(path: str, declared: Dict[str, bool]) -> Tuple[List[Latch], List[str]]:
                 raise ValueError(f"bad entry {e!r}")
             latches.append(Latch(e["holder"], tuple(actions)))
     except (ValueError, KeyError, TypeError, UnicodeDecodeError) as exc:
-        return _fallback(raw, declared, f"latch state {path} is corrupt or foreign ({exc})")
-    problems = []
-    out = []
-    for latch in latches:
-        known = tuple(a for a in latch.actions if a in declared)
-        unknown = [a for a in latch.actions if a not in declared]
-        if unknown:
-            problems.append(f"latch state {path}: {latch.holder} held {', '.join(unknown)}, which the spec does not "
-                            f"declare: cannot hold {'it' if len(unknown) == 1 else 'them'}")
-        if known:
-            out.append(Latch(latch.holder, known))
-    return out, problems
+        return [], str(exc) or exc.__class__.__name__
+    return latches, ""
 
 
 def _fallback(raw: bytes, declared: Dict[str, bool], why: str) -> Tuple[List[Latch], List[str]]:
@@ -114,6 +172,9 @@ class LatchFile:
     def __init__(self, path: Optional[str], spec_path: str = "") -> None:
         self.path = path
         self.spec_path = spec_path
+        # latches of a previous run that this spec cannot hold (undeclared actions): written with
+        # every state until ~reset clears them, so that another restart still knows of them
+        self.kept: List[Latch] = []
         self.error = ""  # the last write error, "" when the file is up to date
         self._last: Optional[Tuple[Latch, ...]] = None
         self._lock = threading.Lock()
@@ -122,7 +183,7 @@ class LatchFile:
         """Write the state if it changed; False (and self.error set) if it could not be written."""
         if self.path is None:
             return True
-        state = tuple(sorted(set(latches), key=lambda l: (l.holder, l.actions)))
+        state = tuple(sorted(set(latches) | set(self.kept), key=lambda l: (l.holder, l.actions)))
         with self._lock:
             if state == self._last and not self.error:
                 return True
@@ -160,4 +221,4 @@ def holders(items: Iterable[Tuple[str, Iterable[str]]]) -> List[Latch]:
     return [Latch(h, tuple(a)) for h, a in items if tuple(a)]
 
 
-__all__: List[Any] = ["Latch", "LatchFile", "default_path", "holders", "load"]
+__all__: List[Any] = ["Latch", "LatchFile", "default_path", "holders", "load", "master_key", "undeclared"]

@@ -14,7 +14,9 @@ Parameters (private)
     ~queue_size (default 100000)  messages the engine's queue holds (and 256 MiB of message bytes)
     ~error_actions (list)         actions to run while a field cannot be read as the spec needs (fail safe)
     ~state_file (string)          latched actions kept across the monitor's restarts (default
-                                  $ROS_HOME/rubass/NODE.latches.json; false: off)
+                                  $ROS_HOME/rubass/NODE.latches.json for a master on this machine
+                                  at port 11311, else NODE.PORT.latches.json, or NODE.HOST.PORT.
+                                  latches.json for another machine's master; false: off)
 Subscribes
     every topic the spec names, whatever its type (rospy.AnyMsg, tcp_nodelay)
     /rubass/agent_samples (std_msgs/String)  the agents' reports: cpu and memory of nodes on
@@ -22,7 +24,9 @@ Subscribes
 Publishes
     /diagnostics (diagnostic_msgs/DiagnosticArray)  one status per entity, one for the monitor
     ~events (std_msgs/String)     one JSON object per behaviour start and release (docs/monitor.md)
-    ~heartbeat (std_msgs/Header)  at the tick rate, from the engine's thread
+    ~heartbeat (std_msgs/Header)  at the tick rate, from the engine's thread (withheld while no spec
+                                  is enforced, and while a latch restored from the state file names an
+                                  action the spec does not declare, until ~reset)
     ~node_samples (std_msgs/String)  each node sample as JSON, so that recordings can replay them
     and whatever the spec's publish actions publish
 Services
@@ -66,7 +70,7 @@ from ..actions.overload import OverloadGuard
 from .clockjump import ClockJump
 from ..actions.errorguard import ErrorGuard
 from ..actions.keeper import LatchKeeper
-from ..actions.latches import LatchFile
+from ..actions.latches import Latch, LatchFile, undeclared
 from .params import MonitorConfig, spec_warnings
 from .gcfreeze import freeze_heap
 from .timerslack import exact_timers
@@ -99,6 +103,7 @@ class Monitor(Reloading):
         self.retired_failures = 0  # failed attempts of runners a reload replaced: `failed action attempts` is since start
         self.loop: Optional[EngineLoop] = None
         self.load_error = ""  # why the monitor is not enforcing, while it is not
+        self.withheld: List[Latch] = []  # latches on actions the spec does not declare: no ~heartbeat meanwhile
 
     # -- start-up ------------------------------------------------------------------------
     def load(self) -> Tuple[CheckedSpec, Dict[str, ActionRunner]]:
@@ -247,6 +252,7 @@ class Monitor(Reloading):
         for runner in runners.values():
             runner.start_thread()
         self.keeper.restore(spec.actions, runners, _ros_now())  # before the first tick
+        self._withhold(spec)
         now = self._first_time()
         engine = Engine(spec, now)
         # inline: a message is evaluated on the thread that received it when the engine is free
@@ -285,9 +291,26 @@ class Monitor(Reloading):
             signal.signal(sig, lambda signum, frame: self._exit.set())
         self.master_watch.start()
 
+    def _withhold(self, spec: CheckedSpec) -> None:
+        """A latch of the previous run on an action this spec does not declare cannot be held: the
+        ~heartbeat is withheld (a watchdog fed by it keeps the robot stopped) until ~reset, and the
+        latch stays in the state file meanwhile (docs/failure-modes.md)."""
+        path = self.keeper.file.path
+        self.withheld = undeclared(path, {n: bool(a.latch) for n, a in spec.actions.items()}) if path else []
+        self.keeper.file.kept = list(self.withheld)
+        if self.withheld:
+            rospy.logerr("rubass: %s: NO ~heartbeat until ~reset: the previous run latched %s, which this spec does "
+                         "not declare (renamed or removed?), so the monitor cannot hold it; a watchdog fed by "
+                         "~heartbeat keeps the robot stopped (ISO 3691-4: no automatic restart after a protective "
+                         "stop)", path, self._withheld_text())
+
+    def _withheld_text(self) -> str:
+        return "; ".join(f"{', '.join(w.actions)} ({w.holder})" for w in self.withheld)
+
     def _tick(self, now: float) -> None:
-        """On the engine's thread at each tick: the heartbeat, then the overload check."""
-        self.outputs.beat(now)
+        """On the engine's thread at each tick: the heartbeat (unless withheld), then the overload check."""
+        if not self.withheld:
+            self.outputs.beat(now)
         loop = self.loop
         assert loop is not None
         was = self.overload.active
@@ -378,6 +401,8 @@ class Monitor(Reloading):
             n += self.overload.reset(now, self.dispatcher.runners)
             n += self.keeper.reset(self.dispatcher.runners, now)
             n += self.error_guard.reset(now, self.dispatcher.runners)
+            n += len(self.withheld)  # the heartbeat resumes: the latch on an undeclared action ends
+            self.withheld = self.keeper.file.kept = []
             self.keeper.save(engine, self.dispatcher.orphans, self._fail_safes())
             return sum(e.kind == "release" for e in events) + n
 
@@ -427,6 +452,12 @@ class Monitor(Reloading):
                 monitor[f"action {name}"] = r.stats.last_error
         failing = status_mod.failing_of({name: r.stats for name, r in self.runners.items()})
         monitor.update(self.keeper.status())
+        withheld = self.withheld
+        if withheld:  # ERROR: the robot is held by the watchdog, not by the monitor
+            monitor["heartbeat"] = "WITHHELD until ~reset"
+            monitor["latch state error"] = "; ".join(  # keeps what else is wrong with the file
+                [f"NO ~heartbeat until ~reset: the previous run latched {self._withheld_text()}, which the spec "
+                 f"does not declare (cannot be held)"] + [e for e in [monitor.get("latch state error", "")] if e])
         monitor["clock jumps back"] = loop.clock_jumps
         if loop.dropped_by_topic:
             monitor["dropped by topic"] = ", ".join(f"{t} {n}" for t, n in sorted(loop.dropped_by_topic.items()))

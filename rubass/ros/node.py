@@ -7,9 +7,11 @@ import signal
 import sys
 from typing import List, Optional
 
+import rosgraph
 import rospy
 
-from ..actions.latches import adopt_old_default, default_path
+from ..actions.latches import adopt_old_default, default_path, master_key
+from .latch_master import is_local
 from .monitor import ConfigError, Monitor
 from .params import KNOWN, ParamError, read_config, unknown_params
 from .rosout_param import keep_rosout_flag
@@ -39,8 +41,10 @@ def main(argv: Optional[List[str]] = None) -> int:
         names = []
     for warning in unknown_params(names, rospy.get_name()):  # a typo must not pass silently
         rospy.logwarn("rubass: %s", warning)
-    state_file = default_path(os.environ.get("ROS_HOME"), rospy.get_name())
-    if rospy.get_name() == "/rubass":  # a plain rosrun was /rubass_monitor before version 2's last stop
+    # one file per node name and master: two monitors of two masters on one machine share none
+    master = master_key(rosgraph.get_master_uri(), is_local)
+    state_file = default_path(os.environ.get("ROS_HOME"), rospy.get_name(), master)
+    if rospy.get_name() == "/rubass" and not master:  # a plain rosrun was /rubass_monitor before version 2's last stop
         old = default_path(os.environ.get("ROS_HOME"), "/rubass_monitor")
         if adopt_old_default(state_file, old):
             rospy.logwarn("rubass: latch state %s moved to %s (the node's new default name)", old, state_file)

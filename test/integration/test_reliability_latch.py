@@ -59,7 +59,7 @@ def test_a_latched_stop_survives_the_monitors_death_until_reset(ros, tmp_path):
     path = spec(tmp_path, BODY)
     mon = ros.monitor(path)
     trigger_and_clear(ros)
-    state = tmp_path / "ros_home" / "rubass" / "rubass.latches.json"
+    state = tmp_path / "ros_home" / "rubass" / f"rubass.{ros.port}.latches.json"  # keyed by the master's port
     assert "stop" in json.loads(state.read_text())["latched"][0]["actions"], "written under $ROS_HOME by default"
     os.killpg(mon.pid, signal.SIGKILL)
     mon.wait(10)
