@@ -127,6 +127,11 @@ def build(spec: CheckedSpec, rules: Dict[str, Any], active: List[int], topics: D
     if monitor.get("agents claiming one host", "none") not in ("none", ""):  # whose values are used is unclear
         level = max(level, WARN)
         msg += f" ({monitor['agents claiming one host']})"
+    latched = sorted({a.action.name for b in spec.behaviours for a in b.actions if a.action.latch})
+    if latched and str(monitor.get("latch state file", "")).startswith("off"):  # ~state_file: false (maybe a leftover)
+        level = max(level, WARN)
+        msg += (f" (LATCH PERSISTENCE OFF: ~state_file is false, so a latched stop ({', '.join(latched)}) will not "
+                f"survive a restart of the monitor; a private parameter stays on the master for later runs)")
     held = "; ".join(monitor[k] for k in HELD if monitor.get(k))
     if held:  # held by nothing the rules now say (a reload, a clock jump, a restart): only ~reset releases it
         level = max(level, WARN)

@@ -11,7 +11,8 @@ Parameters (private)
     ~master_rate (Hz, default 4)  checks that the master still knows the monitor (re-registers
                                   after a master restart: docs/monitor.md)
     ~overload_actions (list)      actions to run while the engine's queue drops messages (fail safe)
-    ~queue_size (default 100000)  messages the engine's queue holds (and 256 MiB of message bytes)
+    ~queue_size (10 to 10000000, default 100000)  messages the engine's queue holds (and 256 MiB
+                                  of message bytes)
     ~error_actions (list)         actions to run while a field cannot be read as the spec needs (fail safe)
     ~state_file (string)          latched actions kept across the monitor's restarts (default
                                   $ROS_HOME/rubass/NODE.latches.json for a master on this machine

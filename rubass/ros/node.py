@@ -13,14 +13,14 @@ import rospy
 from ..actions.latches import adopt_old_default, default_path, master_key
 from .latch_master import is_local
 from .monitor import ConfigError, Monitor
-from .params import KNOWN, ParamError, read_config, unknown_params
+from .params import HELP, ParamError, read_config, unknown_params
 from .rosout_param import keep_rosout_flag
 from .startup import init_node, wants_help
 
 USAGE = ("usage: rosrun rubass monitor _spec:=SPEC.rbs [_actions:=LIBRARY.yaml] [_NAME:=VALUE ...]\n"
          "The rubass monitor node: enforces the rules of SPEC on the live system until stopped (SIGINT/SIGTERM);\n"
-         "SIGHUP or the ~reload service reloads them. Private parameters: " + ", ".join(KNOWN) + "\n"
-         "(see docs/monitor.md). Check a spec first with: rubass check SPEC.rbs --actions LIBRARY.yaml\n")
+         "SIGHUP or the ~reload service reloads them. Private parameters (type, range, default; docs/monitor.md):\n"
+         + HELP + "Check a spec first with: rubass check SPEC.rbs --actions LIBRARY.yaml\n")
 
 
 def main(argv: Optional[List[str]] = None) -> int:

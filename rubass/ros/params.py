@@ -34,6 +34,22 @@ class MonitorConfig:
 KNOWN = ("spec", "actions", "rate", "node_rate", "diagnostics_rate", "master_rate", "overload_actions",
          "queue_size", "error_actions", "state_file")
 
+# `rosrun rubass monitor --help`: each parameter with its type, default and range (read_config checks them)
+HELP = """  ~spec (string, required)          the RuBaSS spec to enforce
+  ~actions (list of paths, [])      action libraries besides the spec's imports
+  ~rate (Hz, 1 to 1000, 50)         scheduler ticks (hold, age/frequency, heartbeat)
+  ~node_rate (Hz, 0.1 to 100, 10)   node samples for alive, cpu, memory
+  ~diagnostics_rate (Hz, 0.1 to 10, 1)  /diagnostics publications
+  ~master_rate (Hz, 0.1 to 100, 4)  checks that the master still knows the monitor
+  ~overload_actions (list, [])      actions to run while the monitor drops messages
+  ~queue_size (int, 10 to 10000000, 100000)  messages the engine's queue holds
+  ~error_actions (list, [])         actions to run while a field cannot be read
+  ~state_file (path or false, under $ROS_HOME/rubass/)  latched actions kept across the
+                                    monitor's restarts; false: none kept (WARN in /diagnostics)
+Private parameters stay on the master after the monitor stops: a later rosrun reads them again
+(rosparam get /rubass; rosparam delete /rubass/NAME).
+"""
+
 
 def unknown_params(names: List[str], node: str, known: Sequence[str] = KNOWN) -> List[str]:
     """A warning for each private parameter of `node` (full names from the master) that it does
