@@ -159,8 +159,11 @@ class BuiltinChecks:
         if self.quant is not None:
             self.error(e.span, f"{e.func}() of an array cannot be used inside {self.quant.func}()")  # type: ignore[attr-defined]
         array, elem = self._array_term(arg)
-        ety = self._field_ty(arg, array=True)  # type: ignore[attr-defined]
+        ety = self._field_ty(arg, array=True, msg_ok=e.func == "len")  # type: ignore[attr-defined]
         out = ast.ArrayFn(e.func, array, elem, span=e.span)
+        if e.func != "len" and ety.kind not in ("num", "any"):  # strings, conditions: as min("a", 1) says
+            self._want_num(ety, arg.span, f"{e.func}()")  # type: ignore[attr-defined]
+            return out, ANY
         return out, (num(COUNT) if e.func == "len" else num(ety.dim if ety.kind == "num" else None))
 
     def _quantifier(self, e: ast.Call) -> Tuple[ast.Expr, Any]:

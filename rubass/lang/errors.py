@@ -3,7 +3,7 @@ from __future__ import annotations
 
 import difflib
 from dataclasses import dataclass, field
-from typing import Iterable, List, Optional, Sequence
+from typing import Dict, Iterable, List, Optional, Sequence
 
 from .source import Span, SourceSet
 
@@ -46,13 +46,25 @@ class RubassError(Exception):
 class SpecError(RubassError):
     """A spec, or an action library it uses, has errors; carries all of them."""
 
-    def __init__(self, diagnostics: Sequence[Diagnostic], sources: Optional[SourceSet] = None) -> None:
-        self.diagnostics: List[Diagnostic] = list(diagnostics)
+    def __init__(self, diagnostics: Sequence[Diagnostic], sources: Optional[SourceSet] = None,
+                 warnings: Sequence[Diagnostic] = ()) -> None:
+        self.diagnostics: List[Diagnostic] = list(diagnostics)  # the errors
+        self.warnings: List[Diagnostic] = [w for w in warnings if w not in self.diagnostics]
         self.sources = sources
         super().__init__(self.render())
 
     def render(self) -> str:
-        return "\n".join(d.render(self.sources) for d in self.diagnostics)
+        """The errors, and the warnings beside them in the order of the text."""
+        return "\n".join(d.render(self.sources) for d in self.in_order())
+
+    def in_order(self) -> List[Diagnostic]:
+        """Errors and warnings by file (in the errors' order of files) and position."""
+        if not self.warnings:
+            return self.diagnostics
+        files: Dict[str, int] = {}
+        for d in self.diagnostics + self.warnings:
+            files.setdefault(d.span.file, len(files))
+        return sorted(self.diagnostics + self.warnings, key=lambda d: (files[d.span.file], d.span.line, d.span.col))
 
 
 def counted(n: int, noun: str) -> str:

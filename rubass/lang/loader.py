@@ -31,9 +31,9 @@ def check_source(src: Source, extra_libraries: Sequence[str] = (), sources: Opti
         spec = parse_source(src)
     except SpecError as exc:
         raise SpecError(exc.diagnostics, sources) from None
-    checked, errors, _ = check(spec, sources, extra_libraries, model)
-    if checked is None:
-        raise SpecError(errors, sources)
+    checked, errors, warnings = check(spec, sources, extra_libraries, model)
+    if checked is None:  # the warnings go beside the errors (SpecError.render)
+        raise SpecError(errors, sources, warnings)
     return checked
 
 

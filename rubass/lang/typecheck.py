@@ -38,6 +38,7 @@ _NUMBER = ("num", "any")  # the kinds a number may have
 BOOL = Ty("bool")
 STR = Ty("str")
 BARE = Ty("num", DIMENSIONLESS, bare=True)
+_ELEM_TYS = {"bool": BOOL, "str": STR}  # the element kinds of an array term that are not numbers
 
 
 _NUM_TYS: Dict[Optional[Dimension], Ty] = {}
@@ -182,8 +183,9 @@ class ExprChecker(BuiltinChecks):
                                    "quantifier must run over the same array")
         return ast.Elem(elem, span=e.span), self._field_ty(e, array=True)
 
-    def _field_ty(self, e: ast.TopicRef, array: bool = False) -> Ty:
-        """What the system model says of a field (no model: unknown kind and dimension)."""
+    def _field_ty(self, e: ast.TopicRef, array: bool = False, msg_ok: bool = False) -> Ty:
+        """What the system model says of a field (no model: unknown kind and dimension); array:
+        of the elements of an array term (messages are an error there unless msg_ok: len())."""
         model = self.scope.model
         info = model.field(e.topic, e.path) if model is not None else None
         if info is None:
@@ -197,7 +199,15 @@ class ExprChecker(BuiltinChecks):
                 self.error(e.span, f"{where} is not an array{': ' + info.why if info.why else ''}")
                 return ANY
             kind = info.elem_kind if info.kind == "array" else info.kind
-            return Ty("num", info.dim) if kind == "num" else ANY
+            if kind == "msg" and not msg_ok:  # an element is a message: the scalar case's error (issue 15)
+                if info.kind == "msg":
+                    self.error(e.span, f"{where} is a message, not a value{': ' + info.why if info.why else ''}; "
+                                       "name one of its fields")
+                else:
+                    self.error(e.span, f"{where} is an array of messages ({info.why}), not of values: name one "
+                                       f"of their fields, e.g. 'topic {e.topic}{e.path_text}[*].FIELD'")
+                return ANY
+            return _ELEM_TYS.get(kind) or (Ty("num", info.dim) if kind == "num" else ANY)
         if info.kind == "array":
             self.error(e.span, f"{where} is an array{' (' + info.why + ')' if info.why else ''}: use min(), "
                                "max() or len() of it, an index such as [0], or any()/all()/count()")
@@ -329,12 +339,16 @@ class ExprChecker(BuiltinChecks):
             self.error(e.span, f"{e.func}() needs an array field or at least two values")
             return e, ANY
         args, tys = [], []
+        wrong = False
         for a in e.args:
             out, ty = self.check(a)
             if ty.kind not in _NUMBER:
                 self._want_num(ty, a.span, f"{e.func}()")
+                wrong, ty = True, ANY  # said once: not again by what uses the call
             args.append(out)
             tys.append(ty)
+        if wrong:
+            return ast.Call(e.func, tuple(args), e.span), ANY
         result = tys[0]
         for t in tys[1:]:
             self._same_dim(result, t, e.span, f"{e.func}() mixes {{}} and {{}}")
