@@ -22,11 +22,13 @@ from ..lang import ast
 from ..lang.fmt import format_expr, format_number
 from ..lang.model import CheckedSpec
 from ..lang.ops import BINARY, UNARY, scalar_fn
-from .arrays import array_fn
+from .arrays import array_fn, element
+from .explain import call_text
 from .store import Store
-from .values import UNKNOWN, as_num
+from .values import UNKNOWN, as_bool
 
-OPAQUE = object()  # a value this walk does not compute (the state of an operator, a quantifier's count)
+OPAQUE = object()  # a value this walk does not compute (the state of an operator)
+_SCAN = 100_000  # elements of one array a quantifier is looked into at most (about 0.1 s, once a second)
 _ARITH = ("+", "-", "*", "/")
 
 
@@ -39,7 +41,7 @@ def rule_reasons(spec: CheckedSpec, store: Store) -> Dict[str, List[str]]:
         if v is True or v is False:
             continue
         try:
-            why = reasons(rule.expr, store)
+            why = reasons(rule.expr, store, getattr(spec, "sources", None))
         except Exception:  # noqa: BLE001 - a bug here must never cost the status: the rule says unknown still
             continue
         if why:
@@ -47,10 +49,11 @@ def rule_reasons(spec: CheckedSpec, store: Store) -> Dict[str, List[str]]:
     return out
 
 
-def reasons(expr: ast.Expr, store: Store) -> List[str]:
-    """Why `expr` (or a part of it) is unknown with the store's values, in reading order, each once."""
+def reasons(expr: ast.Expr, store: Store, sources: Any = None) -> List[str]:
+    """Why `expr` (or a part of it) is unknown with the store's values, in reading order, each once;
+    `sources` (a SourceSet): a quantifier is then quoted as written (with its units)."""
     why: List[str] = []
-    _Walk(store, why).value(expr)
+    _Walk(store, why, sources).value(expr)
     seen: Dict[str, None] = {}
     for w in why:
         seen.setdefault(w, None)
@@ -77,8 +80,9 @@ def _is_num(v: Any) -> bool:
 
 
 class _Walk:
-    def __init__(self, store: Store, why: List[str]) -> None:
-        self.store, self.why = store, why
+    def __init__(self, store: Store, why: List[str], sources: Any = None) -> None:
+        self.store, self.why, self.sources = store, why, sources
+        self.item: Any = None  # the element a quantifier's body is looked at for
 
     def value(self, e: ast.Expr) -> Any:
         """e's value as the engine computes it (UNKNOWN or OPAQUE included), noting computed causes."""
@@ -189,6 +193,44 @@ class _Walk:
                             f"of {what} (all NaN)")
         return v
 
+    def _quant(self, e: ast.Quant) -> Any:
+        """any/all/count as the engine computes them; when unknown, the first element that makes it so."""
+        arr = self.store.fields.get((e.ref.topic, e.ref.path), UNKNOWN)
+        if not isinstance(arr, (tuple, bytes)) or len(arr) > _SCAN:
+            return OPAQUE
+        outer = self.why
+        first: Optional[Tuple[int, List[str]]] = None
+        values = []
+        try:
+            for i, item in enumerate(arr):
+                self.item, self.why = item, []
+                v = self.value(e.body)
+                v = OPAQUE if v is OPAQUE else as_bool(v)
+                if v is UNKNOWN and first is None:
+                    first = (i, self.why)
+                values.append(v)
+        finally:
+            self.why, self.item = outer, None
+        if any(v is OPAQUE for v in values):
+            return OPAQUE
+        if e.func == "count":
+            result: Any = UNKNOWN if first is not None else float(sum(v is True for v in values))
+        elif e.func == "any":
+            result = True if True in values else (UNKNOWN if first is not None else False)
+        else:
+            result = False if False in values else (UNKNOWN if first is not None else True)
+        if result is UNKNOWN and first is not None:
+            i, inner = first
+            self.why.append(f"{self._written(e)}: its condition is unknown for element {i} of {e.ref.topic}"
+                            f"{ast.path_suffix(e.ref.path)}" + (f" ({'; '.join(inner)})" if inner else ""))
+        return result
+
+    def _written(self, e: ast.Expr) -> str:
+        """A call as written in the spec (units kept, `topic` left out, as ~events' witnesses)."""
+        src = self.sources.get(e.span.file) if self.sources is not None else None
+        text = call_text(src.text, e.span.start) if src is not None else None
+        return text or _text(e)
+
     def _builtin(self, e: ast.Expr) -> Any:
         store = self.store
         if isinstance(e, ast.Age):
@@ -213,7 +255,12 @@ class _Walk:
                                 f"{e.ref.path_text.lstrip('.')}, at two different times")
             return v
         if isinstance(e, ast.Quant):
-            return OPAQUE  # its body reads one element at a time: no single value to look into
+            return self._quant(e)
+        if isinstance(e, ast.Elem):
+            v = element(self.item, e.path)
+            if v is UNKNOWN:
+                self.why.append(f"{ast.path_suffix(e.path).lstrip('.') or 'it'} is NaN or missing there")
+            return v
         for child in ast.children(e):  # for, within, latch, zones: look inside
             self.value(child)
         return OPAQUE

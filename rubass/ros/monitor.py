@@ -225,6 +225,10 @@ class Monitor(Reloading):
                                                                          held), time.time())
                     except Exception as exc:  # noqa: BLE001 - the wait goes on; the log says why
                         rospy.logerr_throttle(10, f"rubass: status failed: {exc.__class__.__name__}: {exc}")
+                    if time.monotonic() - started >= 10.0:  # long enough for a simulator to start
+                        rospy.logerr_throttle(60, f"rubass: NOT ENFORCING ANY RULE: use_sim_time is true and no /clock "
+                                                  f"message came for {time.monotonic() - started:.0f} s (is "
+                                                  f"/use_sim_time left set on a real robot?)")
                 self._exit.wait(0.01)
                 now = _ros_now()
             rospy.loginfo("rubass: first /clock message: %.3f s", now)

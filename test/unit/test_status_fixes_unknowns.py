@@ -138,3 +138,22 @@ def test_the_status_lists_the_computed_reason_beside_the_rule():
     assert values["r"] == "unknown"
     assert values["r unknown because"] == "division by zero: topic /a.data / topic /b.data is 1e+200 / 0"
     assert entity.level == status.OK  # unknown, not a data error
+
+
+def test_a_count_made_unknown_by_one_nan_element_names_that_element():
+    e = engine("r: count(topic /scan.ranges[*] < 0.4 m) > 2;")
+    e.on_message("/scan", 1.0, {"ranges": [1.0, math.nan, 0.1]})
+    assert e.store.rules["a.r"] is UNKNOWN
+    assert why(e) == ["count(/scan.ranges[*] < 0.4 m): its condition is unknown for element 1 of "
+                      "/scan.ranges[*] (it is NaN or missing there)"]
+
+
+def test_an_any_decided_by_another_element_is_known_and_gives_no_reason():
+    e = engine("r: any(topic /scan.ranges[*] < 0.4 m);")
+    e.on_message("/scan", 1.0, {"ranges": [math.nan, 0.1]})
+    assert e.store.rules["a.r"] is True
+    assert rule_reasons(e.spec, e.store) == {}
+    e.on_message("/scan", 2.0, {"ranges": [math.nan, 1.0]})
+    assert e.store.rules["a.r"] is UNKNOWN
+    (reason,) = why(e)
+    assert "element 0 of /scan.ranges[*]" in reason, reason
