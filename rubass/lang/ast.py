@@ -21,6 +21,7 @@ class Num:
     value: float
     unit: Optional[str] = None
     span: Span = _span()
+    text: str = field(default="", compare=False, repr=False)  # as written, for the checker's messages
 
 
 @dataclass(frozen=True)
@@ -61,12 +62,21 @@ class Slice:
         return f"[{'' if self.start is None else self.start}:{'' if self.stop is None else self.stop}]"
 
 
-PathElem = Union[str, int, Slice]
+@dataclass(frozen=True)
+class BadIndex:
+    """`[0.5]` in a field path: no index, slice or `[*]`; kept as written (`text`, brackets
+    included) for the checker to report at its place, beside the spec's other errors."""
+
+    text: str
+    span: Span = _span()
+
+
+PathElem = Union[str, int, Slice, BadIndex]
 
 
 def path_suffix(path: Tuple[PathElem, ...]) -> str:
     """A field path as written after a topic name: `.pose.position.x`, `.ranges[0]`, `[0:90]`."""
-    return "".join(p.text if isinstance(p, Slice) else f"[{p}]" if isinstance(p, int) else f".{p}"
+    return "".join(p.text if isinstance(p, (Slice, BadIndex)) else f"[{p}]" if isinstance(p, int) else f".{p}"
                    for p in path)
 
 

@@ -158,6 +158,8 @@ class BuiltinChecks:
         self._dynamic_only(e)
         if self.quant is not None:
             self.error(e.span, f"{e.func}() of an array cannot be used inside {self.quant.func}()")  # type: ignore[attr-defined]
+        if self._path_problem(arg):  # type: ignore[attr-defined]
+            return e, ANY
         array, elem = self._array_term(arg)
         ety = self._field_ty(arg, array=True, msg_ok=e.func == "len")  # type: ignore[attr-defined]
         out = ast.ArrayFn(e.func, array, elem, span=e.span)
@@ -191,8 +193,8 @@ class BuiltinChecks:
                                      f"apply it to the quantifier instead, e.g. ({e.func}(…)) for 1 s")
                 return e, ANY
         nested = any(isinstance(x, ast.Call) and x.func in ("any", "all", "count") for x in ast.walk(body))
-        if ctx.array is None and nested:
-            return e, ANY  # the nested quantifier has been reported: it is the mistake, not a missing array
+        if ctx.array is None and (nested or ctx.reported):
+            return e, ANY  # the nested quantifier or the term's path has been reported: not a missing array too
         if ctx.array is None:
             self.error(e.span, f"{e.func}() needs an array term in its condition, such as "  # type: ignore[attr-defined]
                                        "'topic /diagnostics.status[*].level' or 'topic /scan.ranges[0:90]'")

@@ -304,7 +304,7 @@ class _Parser:
         operand = self.unary()
         self.depth -= _MINUS
         if isinstance(operand, ast.Num):
-            return ast.Num(-operand.value, operand.unit, span=self.span(start))
+            return ast.Num(-operand.value, operand.unit, span=self.span(start), text=operand.text)
         return ast.Unary("-", operand, span=self.span(start))
 
     def primary(self) -> Any:

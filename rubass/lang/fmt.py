@@ -1,6 +1,7 @@
 """The pretty-printer: one canonical layout, comments kept, parse(fmt(x)) == parse(x)."""
 from __future__ import annotations
 
+import math
 from dataclasses import replace
 from typing import Dict, List, Optional, Tuple
 
@@ -13,7 +14,10 @@ _ATOM = 9
 
 
 def format_number(value: float) -> str:
-    """Shortest text that reads back as the same float: 12, 0.4, 1e-06."""
+    """Shortest text that reads back as the same float: 12, 0.4, 1e-06 (1e999 for a number too
+    large, which the checker reports)."""
+    if math.isinf(value):
+        return "1e999" if value > 0 else "-1e999"
     if value.is_integer() and abs(value) < 1e15:
         return str(int(value))
     return repr(value)

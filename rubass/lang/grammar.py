@@ -25,6 +25,7 @@ FUNCTIONS = frozenset(
 _IDENT_RE = r"[A-Za-z_][A-Za-z0-9_]*"
 _GRAPH_RE = rf"~?/?{_IDENT_RE}(?:/{_IDENT_RE})*"
 _INDEX_RE = r"\[\s*-?\d+\s*\]|\[\s*\*\s*\]|\[\s*-?\d*\s*:\s*-?\d*\s*\]"
+_INDEX_RE += r"|\[[^\[\]\n]{0,40}\]"  # any other '[…]' on one line: an ast.BadIndex, the checker's error
 _PATH_RE = rf"(?:\.{_IDENT_RE}|{_INDEX_RE})*"
 _NUM_RE = r"(?:\d+\.\d*|\.\d+|\d+)(?:[eE][-+]?\d+)?"
 _UNIT_RE = r"%|[A-Za-z]+(?:/[A-Za-z]+(?:\^[0-9]+)?)?(?![A-Za-z0-9_])"
@@ -127,7 +128,7 @@ def _climb(s: str, loc: int, toks: Any) -> Any:
 def _unary(s: str, loc: int, toks: Any) -> Any:
     op, operand = toks[0], toks[1]
     if op.text == "-" and isinstance(operand, ast.Num):
-        return ast.Num(-operand.value, operand.unit, span=_span(op.loc))
+        return ast.Num(-operand.value, operand.unit, span=_span(op.loc), text=operand.text)
     return ast.Unary(op.text, operand, span=_span(op.loc))
 
 
@@ -142,11 +143,9 @@ def _for(s: str, loc: int, toks: Any) -> Any:
 
 
 def _number(s: str, loc: int, toks: Any) -> Any:
+    """A number; one too large for a float (1e999) is infinite here, an error of the checker's."""
     unit = toks[1] if len(toks) > 1 else None
-    value = float(toks[0])
-    if value == float("inf"):
-        _fail(s, loc, f"the number '{toks[0]}' is too large (the largest is about 1.8e308)")
-    return ast.Num(value, unit, span=_span(loc))
+    return ast.Num(float(toks[0]), unit, span=_span(loc), text=toks[0])
 
 
 _ESCAPES = {'"': '"', "\\": "\\"}
@@ -175,20 +174,19 @@ def _topic(s: str, loc: int, toks: Any) -> Any:
     m = re.match(_GRAPH_RE, text)
     assert m is not None
     path: List[ast.PathElem] = []
-    slices = 0
     for part in re.finditer(rf"\.({_IDENT_RE})|\[([^\]]*)\]", text[m.end():]):
         if part.group(1):
             path.append(part.group(1))
             continue
         inner = re.sub(r"\s", "", part.group(2))
-        if inner == "*" or ":" in inner:
-            slices += 1
-            if slices > 1:
-                _fail(s, loc, "a field path can run over one array only: one '[*]' or '[A:B]'")
+        if inner == "*" or re.fullmatch(r"(?:-?\d+)?:(?:-?\d+)?", inner):  # a second slice is the checker's error
             a, _, b = inner.partition(":") if inner != "*" else ("", "", "")
             path.append(ast.Slice(int(a) if a else None, int(b) if b else None))
-        else:
+        elif re.fullmatch(r"-?\d+", inner):
             path.append(int(inner))
+        else:  # where the '[' is: after 'topic' and the spaces before the name
+            at = s.find(text, loc) + m.end() + part.start()
+            path.append(ast.BadIndex(part.group(0), span=_span(at, at + len(part.group(0)))))
     return ast.TopicRef(m.group(0), tuple(path), span=_span(loc))
 
 
@@ -396,6 +394,11 @@ def _bad_index(text: str, loc: int) -> Optional[str]:
         return None  # only after a topic's field path
     m = re.match(r"\[[^\]\n]{0,20}\]?", text[loc:])
     bad = m.group(0) if m else "["
+    return bad_index_message(bad)
+
+
+def bad_index_message(bad: str) -> str:
+    """The error for `bad` ('[0.5]') written as an index of a field path."""
     return (f"'{bad}' is not an index: write an integer ([0], [-1]), a slice of integers ([0:90], [-90:]) "
             "or [*] for the whole array")
 

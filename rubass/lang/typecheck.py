@@ -10,7 +10,7 @@ from . import ast
 from .builtins import BuiltinChecks
 from .errors import Diagnostic, a_noun, did_you_mean
 from .fieldmodel import FieldModel
-from .grammar import FUNCTIONS
+from .grammar import FUNCTIONS, bad_index_message
 from .ops import BINARY, SCALAR_FUNCTIONS, UNARY, scalar_fn
 from .source import Span
 from .units import DIMENSIONLESS, ODD, TIME, UNITS, Dimension, dim_mul, dim_sqrt, dimension_name, unit_suggestion
@@ -74,6 +74,7 @@ class _Quant:
 
     func: str
     array: Optional[ast.TopicRef] = None
+    reported: bool = False  # an array term's path was wrong, and said so: not 'needs an array term' too
 
 
 class ExprChecker(BuiltinChecks):
@@ -122,6 +123,9 @@ class ExprChecker(BuiltinChecks):
 
     # -- leaves --------------------------------------------------------------------------
     def _num(self, e: ast.Num) -> Tuple[ast.Expr, Ty]:
+        if not math.isfinite(e.value):  # the parser read 1e999 as infinity
+            self.error(e.span, f"the number '{e.text or '1e999'}' is too large (the largest is about 1.8e308)")
+            return ast.Lit(0.0, span=e.span), ANY
         if e.unit is None:
             return ast.Lit(e.value, span=e.span), BARE
         unit = UNITS.get(e.unit)
@@ -161,6 +165,10 @@ class ExprChecker(BuiltinChecks):
             self.error(e.span, f"'topic {e.topic}' needs a field, e.g. 'topic {e.topic}.data'; "
                                "use age() or frequency() for the topic itself")
             return e, ANY
+        if self._path_problem(e):
+            if self.quant is not None:
+                self.quant.reported = True
+            return e, ANY
         if ast.slice_at(e.path) < 0:
             return e, self._field_ty(e)
         if self.quant is None:
@@ -182,6 +190,17 @@ class ExprChecker(BuiltinChecks):
                                    f"and 'topic {first.topic}{first.path_text}'; every array term inside one "
                                    "quantifier must run over the same array")
         return ast.Elem(elem, span=e.span), self._field_ty(e, array=True)
+
+    def _path_problem(self, e: ast.TopicRef) -> bool:
+        """Report what the parser let through for this check to say beside the spec's other errors:
+        an index that is none ('[0.5]'), a second slice; True when there was one."""
+        bad = [p for p in e.path if isinstance(p, ast.BadIndex)]
+        for p in bad:
+            self.error(p.span, bad_index_message(p.text))
+        if not bad and sum(isinstance(p, ast.Slice) for p in e.path) > 1:
+            self.error(e.span, "a field path can run over one array only: one '[*]' or '[A:B]'")
+            return True
+        return bool(bad)
 
     def _field_ty(self, e: ast.TopicRef, array: bool = False, msg_ok: bool = False) -> Ty:
         """What the system model says of a field (no model: unknown kind and dimension); array:

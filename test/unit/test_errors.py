@@ -122,7 +122,7 @@ def test_all_errors_are_reported_in_one_run(write):
 
 def test_render_is_compiler_style_with_caret(write, tmp_path):
     write("actions.yaml", LIB)
-    path = write("s.rbs", HEAD + "entity e { rules: r: topic /v.x > LIMT; }\n")
+    path = write("s.rbs", HEAD + "entity e { rules: r: topic /v.x > LIMT; }\nif (e.r) then { stop; }\n")  # no warning
     with pytest.raises(SpecError) as info:
         load_spec(path)
     assert str(info.value).splitlines() == [

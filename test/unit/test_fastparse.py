@@ -318,10 +318,9 @@ def test_too_deep_nesting_gives_the_same_error():
      "'(A for T) and B'"),
     ('import "a\\q";', "bad.rbs:1:10: error: unknown escape '\\q' in string (only \\\" and \\\\)"),
     ("entity for { rules: }", "bad.rbs:1:8: error: 'for' is a keyword and cannot be used as a name"),
-    ("const x = 1e999;", "bad.rbs:1:11: error: the number '1e999' is too large (the largest is about 1.8e308)"),
     ("const x = 1;\n\tconst y = (2;", "bad.rbs:2:14: error: expected ')', found ';'"),
-    ("const x = topic /a.b[*].c[0:2];",
-     "bad.rbs:1:11: error: a field path can run over one array only: one '[*]' or '[A:B]'"),
+    # 1e999, two slices in one path and '[0.5]' parse: the checker reports them beside the other errors
+    # (test_checker_fixes_collected.py)
     ('const s = "open', "bad.rbs:1:11: error: unterminated string"),
     ("/* never closed", "bad.rbs:1:1: error: unterminated comment '/*'"),
 ])
