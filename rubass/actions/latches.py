@@ -87,6 +87,32 @@ def adopt_old_default(path: str, old: str) -> bool:
     return True
 
 
+def other_masters(path: str) -> List[str]:
+    """When `path` holds no latch: the state files beside it of the same node for other masters
+    (or another spelling of one) that hold latches. An engineer who changed ROS_MASTER_URI's host
+    spelling between two starts would otherwise lose a protective stop without a word. Sorted."""
+    folder, name = os.path.split(path)
+    if _holds_latches(path):
+        return []
+    node = name.split(".", 1)[0]
+    try:
+        names = sorted(os.listdir(folder))
+    except OSError:
+        return []
+    return [os.path.join(folder, other) for other in names
+            if other != name and other.endswith(".latches.json") and other.split(".", 1)[0] == node
+            and _holds_latches(os.path.join(folder, other))]
+
+
+def _holds_latches(path: str) -> bool:
+    try:
+        with open(path, "rb") as fh:
+            latches, error = _parse(read_at_most(fh, 1 << 20))
+    except OSError:
+        return False
+    return bool(latches) and not error
+
+
 def load(path: str, declared: Dict[str, bool]) -> Tuple[List[Latch], List[str]]:
     """The latches a previous run left (none if there is no file) and the problems found.
 
@@ -221,4 +247,5 @@ def holders(items: Iterable[Tuple[str, Iterable[str]]]) -> List[Latch]:
     return [Latch(h, tuple(a)) for h, a in items if tuple(a)]
 
 
-__all__: List[Any] = ["Latch", "LatchFile", "default_path", "holders", "load", "master_key", "undeclared"]
+__all__: List[Any] = ["Latch", "LatchFile", "default_path", "holders", "load", "master_key", "other_masters",
+                      "undeclared"]
