@@ -32,16 +32,18 @@ _SCAN = 100_000  # elements of one array a quantifier is looked into at most (ab
 _ARITH = ("+", "-", "*", "/")
 
 
-def rule_reasons(spec: CheckedSpec, store: Store) -> Dict[str, List[str]]:
+def rule_reasons(spec: CheckedSpec, store: Store,
+                 field_errors: Optional[Dict[Tuple[str, str], str]] = None) -> Dict[str, List[str]]:
     """rule key -> why it is unknown, computed from the store, for every rule whose value is neither
-    true nor false (empty lists left out)."""
+    true nor false (empty lists left out). `field_errors`: the engine's (topic, path) -> error, fields
+    the data-level reasons already explain (no guess about them here)."""
     out: Dict[str, List[str]] = {}
     for rule in spec.rules:
         v = store.rules.get(rule.key, UNKNOWN)
         if v is True or v is False:
             continue
         try:
-            why = reasons(rule.expr, store, getattr(spec, "sources", None))
+            why = reasons(rule.expr, store, getattr(spec, "sources", None), field_errors)
         except Exception:  # noqa: BLE001 - a bug here must never cost the status: the rule says unknown still
             continue
         if why:
@@ -49,11 +51,14 @@ def rule_reasons(spec: CheckedSpec, store: Store) -> Dict[str, List[str]]:
     return out
 
 
-def reasons(expr: ast.Expr, store: Store, sources: Any = None) -> List[str]:
+def reasons(expr: ast.Expr, store: Store, sources: Any = None,
+            field_errors: Optional[Dict[Tuple[str, str], str]] = None) -> List[str]:
     """Why `expr` (or a part of it) is unknown with the store's values, in reading order, each once;
     `sources` (a SourceSet): a quantifier is then quoted as written (with its units)."""
     why: List[str] = []
-    _Walk(store, why, sources).value(expr)
+    walk = _Walk(store, why, sources)
+    walk.field_errors = field_errors or {}
+    walk.value(expr)
     seen: Dict[str, None] = {}
     for w in why:
         seen.setdefault(w, None)
@@ -83,6 +88,7 @@ class _Walk:
     def __init__(self, store: Store, why: List[str], sources: Any = None) -> None:
         self.store, self.why, self.sources = store, why, sources
         self.item: Any = None  # the element a quantifier's body is looked at for
+        self.field_errors: Dict[Tuple[str, str], str] = {}
 
     def value(self, e: ast.Expr) -> Any:
         """e's value as the engine computes it (UNKNOWN or OPAQUE included), noting computed causes."""
@@ -141,8 +147,8 @@ class _Walk:
         if not e.path:
             return OPAQUE  # a bare topic: only its arrival matters
         v = store.fields.get((e.topic, e.path), UNKNOWN)
-        if v is not UNKNOWN or e.topic not in store.last_arrival:
-            return v  # a value, or no message yet (the data-level reasons say so)
+        if v is not UNKNOWN or e.topic not in store.last_arrival or (e.topic, str(e.path)) in self.field_errors:
+            return v  # a value, or no message yet, or a field error (the data-level reasons say so)
         index = next((i for i, p in enumerate(e.path) if isinstance(p, int)), None)
         if index is not None:
             i = e.path[index]

@@ -431,7 +431,8 @@ class Monitor(Reloading):
             return dict(engine.store.rules), engine.active_behaviours(), dict(engine.field_errors)
 
         rules, active, field_errors = loop.call(snapshot)
-        computed = loop.call(lambda engine: rule_reasons(engine.spec, engine.store))  # at the status rate only
+        # why unknown rules are so, from the values now: at the status rate only, never per message
+        computed = loop.call(lambda engine: rule_reasons(engine.spec, engine.store, engine.field_errors))
         data_errors = loop.call(self._data_errors)
         self.livecheck.use(self.spec, self.config.actions)  # after a reload: the new spec
         self.livecheck.note(self.watcher.carried_types())

@@ -157,3 +157,10 @@ def test_an_any_decided_by_another_element_is_known_and_gives_no_reason():
     assert e.store.rules["a.r"] is UNKNOWN
     (reason,) = why(e)
     assert "element 0 of /scan.ranges[*]" in reason, reason
+
+
+def test_a_field_the_message_lacks_is_left_to_the_data_error_not_called_nan():
+    e = engine("r: topic /a.data > 2;")
+    e.on_message("/a", 1.0, {"other": 1.0})
+    assert e.field_errors and e.store.rules["a.r"] is UNKNOWN
+    assert rule_reasons(e.spec, e.store, e.field_errors) == {}
