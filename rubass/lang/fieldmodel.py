@@ -25,12 +25,14 @@ class FieldInfo:
     is 'msg'), 'msg' (a message, not a value), or 'missing' (the type has no such field: `why`
     says what it lacks, e.g. "nav_msgs/Odometry has no field 'twist.linear'").
     dim: the SI dimension of a number (or of an array's elements) when the type says it (REP 103).
+    warning: something legal but surely not meant (a slice running past a fixed-size array's end).
     """
 
     kind: str
     dim: Optional[Dimension] = None
     why: str = ""
     elem_kind: str = ""
+    warning: str = ""
 
 
 class FieldModel(Protocol):

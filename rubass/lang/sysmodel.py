@@ -2,7 +2,7 @@
 units; the FieldModel the checker asks, and the warnings for topics and nodes it lacks."""
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Dict, Iterator, List, Optional, Set, Tuple
 
 from . import ast
@@ -50,11 +50,12 @@ class SystemModel:
         type_name = self.topics.get(norm_topic(topic))
         if type_name is None:
             return None
-        beyond = _index_beyond(self.registry, type_name, path)
+        beyond, past = _index_beyond(self.registry, type_name, path)
         if beyond is not None:
             return FieldInfo("missing", why=beyond)
-        return resolve(self.registry, type_name, path, (STANDARD_UNITS, self.units),
+        info = resolve(self.registry, type_name, path, (STANDARD_UNITS, self.units),
                        self.topic_units.get(norm_topic(topic)))
+        return replace(info, warning=past) if past and info is not None and info.kind != "missing" else info
 
     def has_stamp(self, topic: str) -> Optional[bool]:
         type_name = self.topics.get(norm_topic(topic))
@@ -82,25 +83,38 @@ class SystemModel:
         return sorted(missing)
 
 
-def _index_beyond(registry: Registry, root: str, path: Tuple[ast.PathElem, ...]) -> Optional[str]:
-    """Why an index of the path is outside a fixed-size array (`position_covariance[9]` of a
-    float64[9]); None when every index fits or a size is not known (other problems are resolve's)."""
+def _index_beyond(registry: Registry, root: str, path: Tuple[ast.PathElem, ...]) -> Tuple[Optional[str], str]:
+    """(why an index or slice of the path is outside a fixed-size array: `position_covariance[9]`
+    or `[40:50]` of a float64[9], a slice that selects no element; a warning for a slice that
+    runs past its end). None and '' when every index fits or a size is not known (other problems
+    are resolve's)."""
     current: Optional[FieldDef] = None
+    past = ""
     for i, elem in enumerate(path):
         if isinstance(elem, str):
             spec = registry.get(root if current is None else current.type)
             current = spec.get(elem) if spec is not None else None
             if current is None:
-                return None
-        elif isinstance(elem, int) and current is not None and current.is_array and current.length is not None:
-            if not -current.length <= elem < current.length:
-                where = ast.path_suffix(path[:i]).lstrip(".")
-                return (f"'{where}[{elem}]' is beyond the end of '{where}', a {current.type}[{current.length}]: "
-                        f"its indices are 0 to {current.length - 1}")
+                return None, past
+        elif isinstance(elem, (int, ast.Slice)) and current is not None and current.is_array \
+                and current.length is not None:
+            n = current.length
+            where = ast.path_suffix(path[:i]).lstrip(".")
+            array = f"'{where}', a {current.type}[{n}]: its indices are 0 to {n - 1}"
+            if isinstance(elem, int) and not -n <= elem < n:
+                return f"'{where}[{elem}]' is beyond the end of {array}", past
+            if isinstance(elem, ast.Slice):
+                chosen = range(n)[elem.start:elem.stop]
+                if not chosen:
+                    return (f"'{where}{elem.text}' selects no element of {array} (a slice is clipped to "
+                            "the array, so this one is always empty)"), past
+                if any(b is not None and not -n <= b <= n for b in (elem.start, elem.stop)):
+                    past = past or (f"'{where}{elem.text}' runs past the end of {array}; it is clipped to "
+                                    f"'{where}[{chosen[0]}:{chosen[-1] + 1}]'")
             current = FieldDef(current.name, current.type)  # its element
         else:
-            return None
-    return None
+            return None, past
+    return None, past
 
 
 def _topic_refs(spec: ast.Spec) -> Iterator[ast.TopicRef]:

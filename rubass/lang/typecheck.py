@@ -213,6 +213,8 @@ class ExprChecker(BuiltinChecks):
         if info.kind == "missing":
             self.error(e.span, info.why or f"{where} is not a field of its type")
             return ANY
+        if info.warning:
+            self.warn(e.span, info.warning)
         if array:
             if info.kind != "array" and ast.slice_at(e.path) < 0:
                 self.error(e.span, f"{where} is not an array{': ' + info.why if info.why else ''}")
@@ -389,7 +391,7 @@ class ExprChecker(BuiltinChecks):
     def _same_dim(self, a: Ty, b: Ty, span: Span, template: str) -> None:
         if a.kind == b.kind == "num" and a.dim is not None and b.dim is not None \
                 and not a.bare and not b.bare and a.dim != b.dim:
-            self.error(span, template.format(a_noun(dimension_name(a.dim)), a_noun(dimension_name(b.dim))))
+            self.error(span, template.format(_dim_noun(a.dim), _dim_noun(b.dim)))
 
 
 def _join(a: Ty, b: Ty) -> Ty:
@@ -402,6 +404,11 @@ def _join(a: Ty, b: Ty) -> Ty:
     if b.bare or b.dim is None:
         return a if a.dim is not None else b
     return a
+
+
+def _dim_noun(d: Dimension) -> str:
+    """'a length', 'a plain number' (no dimension: a quaternion's component, cpu(), 50 %)."""
+    return "a plain number" if d == DIMENSIONLESS else a_noun(dimension_name(d))
 
 
 def _describe(ty: Ty) -> str:

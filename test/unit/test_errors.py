@@ -69,7 +69,7 @@ CASES = [
      (3, 36, "compares a time with a length")),
     ("comparing a share with memory",
      HEAD + "entity e: n { rules: r: cpu(node n) > 2 MB; }\nif (e.r) then { stop; }\n",
-     (3, 37, "compares a share with a memory")),
+     (3, 37, "compares a plain number with a memory")),
     ("adding speed and time",
      HEAD + "entity e { rules: r: topic /v.x + 1 m/s + 2 s > 0; }\nif (e.r) then { stop; }\n",
      (3, 41, "cannot add or subtract a speed and a time")),
