@@ -8,10 +8,11 @@ expression itself makes out of values that are there: a division by zero, NaN fr
 empty array or slice (or of one with only NaN, or no valid laser reading), a field that is NaN, a
 frequency window not yet full, a missing header stamp, a rule that is itself unknown.
 
-It walks a rule's expression with the store's current values when the status is built (about once
-a second, on the engine's thread), never per message: the evaluation closures stay as they are. It
-reads the store and writes nothing; stateful operators (`for`, `within`, `latch`) are only looked
-into, their state is theirs.
+It walks a rule's expression with the store's values when the status is built (about once a second),
+never per message: the evaluation closures stay as they are. The monitor takes a `snapshot` of the
+store on the engine's thread (microseconds) and walks it on its own status thread, so a long array
+never holds the engine. It writes nothing; stateful operators (`for`, `within`, `latch`) are only
+looked into, their state is theirs.
 """
 from __future__ import annotations
 
@@ -28,8 +29,20 @@ from .store import Store
 from .values import UNKNOWN, as_bool
 
 OPAQUE = object()  # a value this walk does not compute (the state of an operator)
-_SCAN = 100_000  # elements of one array a quantifier is looked into at most (about 0.1 s, once a second)
+_SCAN = 20_000  # elements of an array a quantifier is looked into at most (~30 ms of the status thread)
 _ARITH = ("+", "-", "*", "/")
+
+
+def snapshot(store: Store) -> Store:
+    """A copy of what the walk reads, taken on the engine's thread in microseconds (arrays are immutable
+    and shared), so that the walk itself runs on another thread and never holds the engine."""
+    snap = Store(store.now, store.origin)
+    snap.fields, snap.rules, snap.nodes = dict(store.fields), dict(store.rules), dict(store.nodes)
+    snap.last_arrival, snap.watch_start = dict(store.last_arrival), dict(store.watch_start)
+    snap.stamps, snap.rates, snap.laser_limits = dict(store.stamps), dict(store.rates), dict(store.laser_limits)
+    snap._arrivals = {t: list(a) for t, a in store._arrivals.items()}  # frequency()
+    snap._window = dict(store._window)
+    return snap
 
 
 def rule_reasons(spec: CheckedSpec, store: Store,

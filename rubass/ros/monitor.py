@@ -51,7 +51,7 @@ from std_srvs.srv import Trigger, TriggerResponse
 
 from ..engine import Engine, Event
 from ..engine.loop import EngineLoop, Message, NodeSample
-from ..engine.unknowns import rule_reasons
+from ..engine.unknowns import rule_reasons, snapshot as store_snapshot
 from ..lang import SpecError, load_spec
 from ..lang.errors import counted
 from ..lang.library import priority_conflicts
@@ -431,8 +431,11 @@ class Monitor(Reloading):
             return dict(engine.store.rules), engine.active_behaviours(), dict(engine.field_errors)
 
         rules, active, field_errors = loop.call(snapshot)
-        # why unknown rules are so, from the values now: at the status rate only, never per message
-        computed = loop.call(lambda engine: rule_reasons(engine.spec, engine.store, engine.field_errors))
+        # why unknown rules are so, from the values now: at the status rate only, never per message; the
+        # store is copied on the engine's thread (µs) and walked on this one (never holding the engine)
+        engine_spec, store, errors = loop.call(
+            lambda engine: (engine.spec, store_snapshot(engine.store), dict(engine.field_errors)))
+        computed = rule_reasons(engine_spec, store, errors)
         data_errors = loop.call(self._data_errors)
         self.livecheck.use(self.spec, self.config.actions)  # after a reload: the new spec
         self.livecheck.note(self.watcher.carried_types())

@@ -164,3 +164,15 @@ def test_a_field_the_message_lacks_is_left_to_the_data_error_not_called_nan():
     e.on_message("/a", 1.0, {"other": 1.0})
     assert e.field_errors and e.store.rules["a.r"] is UNKNOWN
     assert rule_reasons(e.spec, e.store, e.field_errors) == {}
+
+
+def test_a_snapshot_gives_the_same_reasons_and_does_not_follow_later_messages():
+    from rubass.engine.unknowns import snapshot
+    e = engine("r: topic /a.data / topic /b.data > 2 or frequency(topic /a) > 9;")
+    e.on_message("/a", 1.0, {"data": 1.0})
+    e.on_message("/b", 1.0, {"data": 0.0})
+    snap = snapshot(e.store)
+    assert rule_reasons(e.spec, snap) == rule_reasons(e.spec, e.store)
+    e.on_message("/b", 1.5, {"data": 0.25})  # the engine goes on; the snapshot stays as it was
+    assert "division by zero" in rule_reasons(e.spec, snap)["a.r"][0]
+    assert not any("division" in r for r in rule_reasons(e.spec, e.store).get("a.r", []))
