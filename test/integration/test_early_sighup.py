@@ -8,6 +8,7 @@ import signal
 import socket
 import subprocess
 import sys
+import threading
 import time
 
 import pytest
@@ -42,6 +43,8 @@ def test_a_sighup_right_after_start_does_not_end_the_process(tmp_path, script):
     started = time.monotonic()
     proc = subprocess.Popen([sys.executable, os.path.join(ROOT, "scripts", script), param], env=_env(tmp_path),
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, start_new_session=True)
+    guard = threading.Timer(60.0, proc.kill)  # a process that hangs silently must not hang the test run
+    guard.start()
     try:
         end = time.monotonic() + 10.0
         while not _ignores_sighup(proc.pid) and proc.poll() is None and time.monotonic() < end:
@@ -63,6 +66,7 @@ def test_a_sighup_right_after_start_does_not_end_the_process(tmp_path, script):
         assert proc.returncode != -signal.SIGHUP and proc.returncode != 128 + signal.SIGHUP, (proc.returncode, err)
         assert "Traceback" not in err, err
     finally:
+        guard.cancel()
         if proc.poll() is None:
             proc.kill()
             proc.wait()
