@@ -249,6 +249,9 @@ class BuiltinChecks:
             coords = []
             for c in (a.x, a.y):
                 lit, ty = self.check(c)  # type: ignore[attr-defined]
+                if isinstance(lit, ast.Lit) and ty.kind == "any":  # an unknown unit, 1e999: reported already
+                    ok = False
+                    continue
                 if not isinstance(lit, ast.Lit) or not isinstance(lit.value, float) or ty.kind != "num":
                     self.error(c.span, "a vertex's coordinates must be constant lengths, e.g. (4 m, 0 m)")  # type: ignore[attr-defined]
                     ok = False

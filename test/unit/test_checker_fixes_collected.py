@@ -136,3 +136,13 @@ def test_any_bracket_after_a_path_is_an_index_a_slice_or_one_error_at_its_bracke
         assert line == 2 and message.startswith(("'[", "a slice", "an array term", "the")), got
         if message.startswith("'["):
             assert (col, message) == (len(head.split("\n")[-1]) + 1, not_an_index(f"[{inner}]")), got
+
+
+@pytest.mark.parametrize("rule, col", [
+    ("a: (topic /s.r > 1) for 1e999 s;", 27),
+    ("a: inside(topic /p.x, topic /p.y, polygon((1e999 m, 0 m), (1 m, 0 m), (0 m, 1 m)));", 46),
+    ("a: inside(topic /p.x, topic /p.y, polygon((1 parsec, 0 m), (1 m, 0 m), (0 m, 1 m)));", 46),
+])
+def test_a_number_too_large_or_a_bad_unit_is_one_error_wherever_it_is(tmp_path, rule, col):
+    got = errors(tmp_path, f"entity e {{ rules:\n  {rule}\n}}\nif (e.a) then {{ warn; }}\n")
+    assert len(got) == 1 and got[0][:2] == (4, col), got

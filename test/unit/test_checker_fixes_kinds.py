@@ -162,3 +162,13 @@ def test_the_recordings_joint_names_are_strings_inside_quantifiers(tmp_path):
             "if (j.named or j.any_hi or j.mx) then { warn; }\n")
     assert errors(tmp_path, model, body) == [
         (4, 42, STRING_NUMBER), (5, 17, NOT_A_NUMBER), (6, 11, "max() needs a number, not a string")]
+
+
+def test_the_live_monitor_finds_the_same_error_once_the_types_are_known(tmp_path):
+    """rubass/ros/livecheck.py checks the running spec with the types the topics carry: same checker."""
+    from rubass.ros.livecheck import live_errors  # pure: no rospy
+
+    spec = _check(tmp_path, None, "r: if (any(topic /js.name[*] == 1) or max(topic /js.name) > 0) then { warn; }\n")
+    got = live_errors(spec, [], {"/js": ("t_msgs/Joints", "string[] name\nfloat64[] position\n")})
+    assert [e.splitlines()[0].split(": ", 1)[1] for e in got] == [
+        "error: '==' compares a string with a number", "error: max() needs a number, not a string"]
