@@ -45,7 +45,7 @@ class Crossings:
 
     __slots__ = ("diffs", "windows", "store", "due", "at")
 
-    def __init__(self, diffs: List[Dual], windows: List[Tuple[str, float]], store: Store) -> None:
+    def __init__(self, diffs: List[Tuple[Dual, bool]], windows: List[Tuple[str, float]], store: Store) -> None:
         self.diffs, self.windows, self.store = diffs, windows, store
         self.due: Optional[float] = None
         self.at = float("-inf")
@@ -53,11 +53,11 @@ class Crossings:
     def update(self) -> None:
         now = self.at = self.store.now
         best = math.inf
-        for diff in self.diffs:
+        for diff, exact in self.diffs:
             value, slope, curve = diff()
             if value is UNKNOWN:
                 continue
-            h = step_to_zero(value, slope, curve)
+            h = step_to_zero(value, slope, curve, exact)
             if h is not None:
                 best = min(best, now + max(h, 0.0) + CROSSING_MARGIN)
         for topic, window in self.windows:
@@ -79,21 +79,28 @@ class Crossings:
         pass
 
 
-def step_to_zero(value: float, slope: float, curve: float) -> Optional[float]:
-    """How long until a difference of (value, slope, curvature) reaches zero, by the earlier of its
-    first- and second-order approximations (exact for a linear or quadratic one); None if neither
-    reaches it. A root up to CROSSING_MARGIN in the past counts (it is being crossed now)."""
+def step_to_zero(value: float, slope: float, curve: float, exact: bool = False) -> Optional[float]:
+    """How long until a difference of (value, slope, curvature) reaches zero: its first root ahead
+    when it is `exact`ly a quadratic (or linear) in time, else the earlier of its first- and
+    second-order approximations; None if none reaches it. A root up to CROSSING_MARGIN in the
+    past counts (it is being crossed now)."""
+    if curve == 0.0 and math.isfinite(slope):  # sums and scalings of ages: exact, and the common case
+        if not slope:
+            return None
+        h = -value / slope
+        return h if h >= -CROSSING_MARGIN else None
     if not math.isfinite(slope) or not math.isfinite(curve):
-        toward = (slope > 0) != (value > 0) if math.isinf(slope) else True
+        toward = (slope > 0) != (value > 0) if slope and not math.isnan(slope) else True
         return SINGULAR_STEP if value != 0.0 and math.isfinite(value) and toward else None
     steps = []
-    if slope:
+    if slope and not exact:
         steps.append(-value / slope)
-    if curve:
-        disc = slope * slope - 2.0 * curve * value
-        if disc >= 0.0:
-            root = math.sqrt(disc)
-            steps += [(-slope - root) / curve, (-slope + root) / curve]
+    disc = slope * slope - 2.0 * curve * value
+    if -1e-9 * slope * slope <= disc < 0.0:
+        disc = 0.0  # a double root, rounded below zero (sqrt((age - 3 s) * (age - 3 s)))
+    if disc >= 0.0:
+        root = math.sqrt(disc)
+        steps += [(-slope - root) / curve, (-slope + root) / curve]
     ahead = [h for h in steps if h >= -CROSSING_MARGIN]
     return min(ahead) if ahead else None
 
@@ -102,7 +109,7 @@ def crossings(expr: ast.Expr, value_of: Callable[[ast.Expr], Callable[[], Any]],
     """The Crossings of one rule or behaviour expression, or None when nothing in it changes
     with time alone. `value_of` compiles a sub-expression (the engine's own closures)."""
     duals = _Duals(value_of, store)
-    diffs: List[Dual] = []
+    diffs: List[Tuple[Dual, bool]] = []
     windows: List[Tuple[str, float]] = []
     stack = [expr]
     while stack:
@@ -112,22 +119,54 @@ def crossings(expr: ast.Expr, value_of: Callable[[ast.Expr], Callable[[], Any]],
         if isinstance(e, ast.Frequency):
             windows.append((e.topic, e.window))
         if isinstance(e, ast.Binary) and e.op in _COMPARE and (time_dependent(e.left) or time_dependent(e.right)):
-            diffs.append(duals.difference(e.left, e.right))
+            diffs.append((duals.difference(e.left, e.right), _exact(e.left, e.right)))
         elif isinstance(e, ast.Call) and time_dependent(e):
             args = e.args
             if e.func in ("min", "max"):
-                diffs += [duals.difference(a, b) for i, a in enumerate(args) for b in args[i + 1:]
+                diffs += [(duals.difference(a, b), _exact(a, b)) for i, a in enumerate(args) for b in args[i + 1:]
                           if time_dependent(a) or time_dependent(b)]
             elif e.func in ("abs", "sqrt"):
-                diffs.append(duals.dual(args[0]))
+                diffs.append((duals.dual(args[0]), _exact(args[0])))
+            elif e.func == "hypot":  # a kink where its arguments are all 0: looked at where each is
+                diffs += [(duals.dual(a), _exact(a)) for a in args if time_dependent(a)]
         stack.extend(ast.children(e))
     if not diffs and not windows:
         return None
     return Crossings(diffs, windows, store)
 
 
+def _exact(*sides: ast.Expr) -> bool:
+    """Whether numbers are, between inputs, polynomials of degree <= 2 in time (piecewise, at the
+    kinks of abs/min/max, which are crossings of their own): then the quadratic step is exact."""
+    degrees = [_degree(e) for e in sides]
+    return all(d is not None and d <= 2 for d in degrees)
+
+
+def _degree(e: ast.Expr) -> Optional[int]:
+    """The degree in time of a number between inputs, None when it is not a polynomial."""
+    if not time_dependent(e):
+        return 0
+    if isinstance(e, (ast.Age, ast.StampAge)):
+        return 1
+    if isinstance(e, ast.Unary) and e.op == "-":
+        return _degree(e.operand)
+    if isinstance(e, ast.Binary) and e.op in "+-*/":
+        left, right = _degree(e.left), _degree(e.right)
+        if left is None or right is None:
+            return None
+        if e.op == "*":
+            return left + right
+        if e.op == "/":
+            return left if right == 0 else None
+        return max(left, right)
+    if isinstance(e, ast.Call) and e.func in ("abs", "min", "max"):
+        degrees = [_degree(a) for a in e.args]
+        return None if any(d is None for d in degrees) else max(degrees)
+    return None
+
+
 class _Duals:
-    """Compiles numbers into (value, slope) closures."""
+    """Compiles numbers into (value, slope, curvature) closures."""
 
     def __init__(self, value_of: Callable[[ast.Expr], Callable[[], Any]], store: Store) -> None:
         self.value_of, self.store = value_of, store

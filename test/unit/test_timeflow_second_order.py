@@ -73,6 +73,7 @@ def test_a_quadratic_step_is_its_first_root_ahead(v, s, c):
     (an earlier look is allowed: the tangent's root, where the function is not known to be a
     quadratic); it is that root when the slope is 0 or the difference is linear."""
     h = step_to_zero(v, s, c)
+    exact = step_to_zero(v, s, c, exact=True)
     roots = []
     if c:
         disc = s * s - 2 * c * v
@@ -83,6 +84,7 @@ def test_a_quadratic_step_is_its_first_root_ahead(v, s, c):
     ahead = [r for r in roots if r >= -CROSSING_MARGIN]
     if ahead:
         assert h is not None and h <= min(ahead) + 1e-9 * (1 + abs(min(ahead)))
+        assert exact is not None and math.isclose(exact, min(ahead), rel_tol=1e-9, abs_tol=1e-9)
         if not s or not c:
             assert math.isclose(h, min(ahead), rel_tol=1e-9, abs_tol=1e-9)
     elif not s:
@@ -92,3 +94,20 @@ def test_a_quadratic_step_is_its_first_root_ahead(v, s, c):
 def test_a_singular_slope_looks_again_soon_only_when_moving_toward_the_crossing():
     assert step_to_zero(-0.5, math.inf, 0.0) is not None  # sqrt just left 0, threshold ahead
     assert step_to_zero(0.5, math.inf, 0.0) is None  # already past it, moving away
+
+
+def test_a_kink_of_hypot_and_a_double_root_are_met_at_their_instant():
+    """Review findings: hypot's kink was not a crossing (a start one tick late), and a double root
+    rounded below zero was approached by halving the distance."""
+    for cond in ("hypot(age(topic /a) - 3 s, 0 s) > 0.001 s", "abs(age(topic /a) - 3 s) > 0.001 s",
+                 "sqrt((age(topic /a) - 3 s) * (age(topic /a) - 3 s) * 1) > 0.001 s"):
+        got = first_start(cond, until=9.0, arrival=1.0)
+        assert got is not None and 4.001 - 1e-9 <= got <= 4.001 + 1e-5, (cond, got)
+    h = step_to_zero(4.0, -4.0, 2.0 * (1 + 4e-16), exact=True)  # (h - 2)^2, the discriminant rounded below 0
+    assert h is not None and abs(h - 2.0) < 1e-6
+
+
+def test_an_infinite_curvature_moving_away_plans_nothing():
+    assert step_to_zero(2.0, 1.0, math.nan) is None
+    assert step_to_zero(2.0, 1.0, math.inf) is None
+    assert step_to_zero(-2.0, 1.0, math.inf) is not None
