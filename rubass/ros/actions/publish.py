@@ -105,10 +105,12 @@ class PublishPlugin(ActionPlugin):
 
     def release(self, ctx: Context) -> Any:
         try:
-            if self.release_msg is not None and self.pub is not None:
-                self._publish(self.release_msg, self.release_stamp)
+            if self.release_msg is not None and self.pub is not None and self._publish(self.release_msg,
+                                                                                        self.release_stamp):
                 return None
-            return NOTHING_DONE  # nothing published: a failed start is not shown fixed by it
+            # nothing published (no on_release, or a higher-priority action owns the topic): a
+            # failed start is not shown fixed by it
+            return NOTHING_DONE
         finally:
             self.seat.deactivate()  # after on_release: the next action on the topic is woken to publish
 
