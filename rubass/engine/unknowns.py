@@ -29,7 +29,7 @@ from .store import Store
 from .values import UNKNOWN, as_bool
 
 OPAQUE = object()  # a value this walk does not compute (the state of an operator)
-_SCAN = 20_000  # elements of an array a quantifier is looked into at most (~30 ms of the status thread)
+_SCAN = 5_000  # elements of an array a quantifier is looked into at most (~12 ms of the status thread)
 _ARITH = ("+", "-", "*", "/")
 
 
@@ -78,13 +78,6 @@ def reasons(expr: ast.Expr, store: Store, sources: Any = None,
     return list(seen)
 
 
-def _text(e: ast.Expr) -> str:
-    try:
-        return format_expr(e)
-    except Exception:  # noqa: BLE001 - a construct the printer does not know: still a reason
-        return type(e).__name__
-
-
 def _num(v: Any) -> str:
     if v is True or v is False:
         return "true" if v else "false"
@@ -101,6 +94,7 @@ class _Walk:
     def __init__(self, store: Store, why: List[str], sources: Any = None) -> None:
         self.store, self.why, self.sources = store, why, sources
         self.item: Any = None  # the element a quantifier's body is looked at for
+        self.arr: Optional[ast.TopicRef] = None  # that quantifier's array (to print an element `[*]`)
         self.field_errors: Dict[Tuple[str, str], str] = {}
 
     def value(self, e: ast.Expr) -> Any:
@@ -138,9 +132,9 @@ class _Walk:
         v = BINARY[e.op](left, right)
         if v is UNKNOWN and e.op in _ARITH and _is_num(left) and _is_num(right):
             if e.op == "/" and right == 0.0:
-                self.why.append(f"division by zero: {_text(e)} is {_num(left)} / {_num(right)}")
+                self.why.append(f"division by zero: {self._say(e)} is {_num(left)} / {_num(right)}")
             else:  # inf - inf, 0 * inf, inf / inf: not a number
-                self.why.append(f"not a number: {_text(e)} is {_num(left)} {e.op} {_num(right)}")
+                self.why.append(f"not a number: {self._say(e)} is {_num(left)} {e.op} {_num(right)}")
         return v
 
     def _call(self, e: ast.Call) -> Any:
@@ -150,9 +144,9 @@ class _Walk:
         v = scalar_fn(e.func)(*vals)
         if v is UNKNOWN and all(_is_num(x) for x in vals):
             if e.func == "sqrt" and vals[0] < 0:
-                self.why.append(f"sqrt of a negative number: {_text(e)} is sqrt({_num(vals[0])})")
+                self.why.append(f"sqrt of a negative number: {self._say(e)} is sqrt({_num(vals[0])})")
             else:
-                self.why.append(f"not a number: {_text(e)} of {', '.join(_num(x) for x in vals)}")
+                self.why.append(f"not a number: {self._say(e)} of {', '.join(_num(x) for x in vals)}")
         return v
 
     def _field(self, e: ast.TopicRef) -> Any:
@@ -169,16 +163,16 @@ class _Walk:
             size = self._length(e.topic, e.path[:index])
             assert isinstance(i, int)
             if size is not None and not -size <= i < size:
-                self.why.append(f"index out of range: {_text(e)} in an array of {size} element"
+                self.why.append(f"index out of range: {self._say(e)} in an array of {size} element"
                                 f"{'' if size == 1 else 's'} ({array} in the last message)")
             elif size is None:
                 need = i + 1 if i >= 0 else -i
-                self.why.append(f"{_text(e)}: {array} in the last message has fewer than {need} element"
+                self.why.append(f"{self._say(e)}: {array} in the last message has fewer than {need} element"
                                 f"{'' if need == 1 else 's'} (index out of range), or that element is NaN")
             else:
-                self.why.append(f"{_text(e)} is NaN in the last message")
+                self.why.append(f"{self._say(e)} is NaN in the last message")
         else:
-            self.why.append(f"{_text(e)} is NaN (or unreadable) in the last message")
+            self.why.append(f"{self._say(e)} is NaN (or unreadable) in the last message")
         return v
 
     def _length(self, topic: str, path: Tuple[ast.PathElem, ...]) -> Optional[int]:
@@ -201,14 +195,14 @@ class _Walk:
         what = f"{e.ref.topic}{e.ref.path_text}"
         if not arr:
             full = self._length(e.ref.topic, e.ref.path[:ast.slice_at(e.ref.path)]) if sliced else None
-            self.why.append(f"{_text(e)} of an empty {'slice' if sliced else 'array'}: {what} has no element"
+            self.why.append(f"{self._say(e)} of an empty {'slice' if sliced else 'array'}: {what} has no element"
                             f" in the last message" + (f" (the array has {full})" if full is not None else ""))
         elif limits is not None and limits() is not None:
             lo, hi = limits()  # type: ignore[misc]
-            self.why.append(f"{_text(e)}: no valid reading among the {len(arr)} of {what} (all NaN, +inf or "
+            self.why.append(f"{self._say(e)}: no valid reading among the {len(arr)} of {what} (all NaN, +inf or "
                             f"outside [range_min {_num(lo)}, range_max {_num(hi)}], REP 117)")
         else:
-            self.why.append(f"{_text(e)}: no number among the {len(arr)} element{'' if len(arr) == 1 else 's'} "
+            self.why.append(f"{self._say(e)}: no number among the {len(arr)} element{'' if len(arr) == 1 else 's'} "
                             f"of {what} (all NaN)")
         return v
 
@@ -217,7 +211,8 @@ class _Walk:
         arr = self.store.fields.get((e.ref.topic, e.ref.path), UNKNOWN)
         if not isinstance(arr, (tuple, bytes)) or len(arr) > _SCAN:
             return OPAQUE
-        outer = self.why
+        outer, outer_arr = self.why, self.arr
+        self.arr = e.ref
         first: Optional[Tuple[int, List[str]]] = None
         values = []
         try:
@@ -229,7 +224,7 @@ class _Walk:
                     first = (i, self.why)
                 values.append(v)
         finally:
-            self.why, self.item = outer, None
+            self.why, self.item, self.arr = outer, None, outer_arr
         if any(v is OPAQUE for v in values):
             return OPAQUE
         if e.func == "count":
@@ -244,11 +239,18 @@ class _Walk:
                             f"{ast.path_suffix(e.ref.path)}" + (f" ({'; '.join(inner)})" if inner else ""))
         return result
 
+    def _say(self, e: ast.Expr) -> str:
+        """An expression printed; inside a quantifier's body its element as `topic /a.data[*]`."""
+        try:
+            return format_expr(e, 0, self.arr)
+        except Exception:  # noqa: BLE001 - a construct the printer does not know: still a reason
+            return type(e).__name__
+
     def _written(self, e: ast.Expr) -> str:
         """A call as written in the spec (units kept, `topic` left out, as ~events' witnesses)."""
         src = self.sources.get(e.span.file) if self.sources is not None else None
         text = call_text(src.text, e.span.start) if src is not None else None
-        return text or _text(e)
+        return text or self._say(e)
 
     def _builtin(self, e: ast.Expr) -> Any:
         store = self.store
@@ -257,20 +259,20 @@ class _Walk:
         if isinstance(e, ast.Frequency):
             v = store.frequency(e.topic, e.window)
             if v is UNKNOWN and e.topic in store.watch_start:
-                self.why.append(f"{_text(e)}: {e.topic} watched for less than its "
+                self.why.append(f"{self._say(e)}: {e.topic} watched for less than its "
                                 f"{format_number(e.window)} s window yet")
             return v
         if isinstance(e, ast.StampAge):
             v = store.stamp_age(e.topic)
             if v is UNKNOWN and e.topic in store.last_arrival:
-                self.why.append(f"{_text(e)}: the last message on {e.topic} has a zero header.stamp, or none")
+                self.why.append(f"{self._say(e)}: the last message on {e.topic} has a zero header.stamp, or none")
             return v
         if isinstance(e, ast.NodeStat):
             return store.node_value(e.node, e.attr)  # the data-level reasons say why a node is unknown
         if isinstance(e, ast.Rate):
             v = store.rates.get((e.ref.topic, e.ref.path), UNKNOWN)
             if v is UNKNOWN and e.ref.topic in store.last_arrival:
-                self.why.append(f"{_text(e)}: needs two messages on {e.ref.topic} with a number in "
+                self.why.append(f"{self._say(e)}: needs two messages on {e.ref.topic} with a number in "
                                 f"{e.ref.path_text.lstrip('.')}, at two different times")
             return v
         if isinstance(e, ast.Quant):

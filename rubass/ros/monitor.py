@@ -427,15 +427,17 @@ class Monitor(Reloading):
             return
         loop = self.loop
 
-        def snapshot(engine: Engine) -> Tuple[Dict[str, Any], List[int], Dict[Tuple[str, str], str]]:
-            return dict(engine.store.rules), engine.active_behaviours(), dict(engine.field_errors)
+        def snapshot(engine: Engine) -> Tuple[Dict[str, Any], List[int], Dict[Tuple[str, str], str], Any, Any]:
+            rules = dict(engine.store.rules)
+            unknown = any(rules.get(r.key) is not True and rules.get(r.key) is not False for r in engine.spec.rules)
+            # the store only when a rule is unknown: it is copied here (µs), walked on this thread
+            return (rules, engine.active_behaviours(), dict(engine.field_errors), engine.spec,
+                    store_snapshot(engine.store) if unknown else None)
 
-        rules, active, field_errors = loop.call(snapshot)
-        # why unknown rules are so, from the values now: at the status rate only, never per message; the
-        # store is copied on the engine's thread (µs) and walked on this one (never holding the engine)
-        engine_spec, store, errors = loop.call(
-            lambda engine: (engine.spec, store_snapshot(engine.store), dict(engine.field_errors)))
-        computed = rule_reasons(engine_spec, store, errors)
+        rules, active, field_errors, engine_spec, store = loop.call(snapshot)
+        # why unknown rules are so, from the values of the same instant as `rules`: at the status rate
+        # only, never per message, and never holding the engine
+        computed = rule_reasons(engine_spec, store, field_errors) if store is not None else {}
         data_errors = loop.call(self._data_errors)
         self.livecheck.use(self.spec, self.config.actions)  # after a reload: the new spec
         self.livecheck.note(self.watcher.carried_types())

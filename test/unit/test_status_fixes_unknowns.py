@@ -176,3 +176,12 @@ def test_a_snapshot_gives_the_same_reasons_and_does_not_follow_later_messages():
     e.on_message("/b", 1.5, {"data": 0.25})  # the engine goes on; the snapshot stays as it was
     assert "division by zero" in rule_reasons(e.spec, snap)["a.r"][0]
     assert not any("division" in r for r in rule_reasons(e.spec, e.store).get("a.r", []))
+
+
+def test_a_reason_inside_a_quantifier_quotes_the_term_as_written_not_a_class_name():
+    """Review finding: the printer does not know an element `[*]`, so the reason read "Binary is 1 / 0"."""
+    e = engine("r: any(topic /a.data[*] / 0 > 1);")
+    e.on_message("/a", 1.0, {"data": [1.0]})
+    assert e.store.rules["a.r"] is UNKNOWN
+    got = " ".join(why(e))
+    assert "Binary" not in got and "division by zero: topic /a.data[*] / 0 is 1 / 0" in got, got
