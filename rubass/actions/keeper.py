@@ -10,8 +10,8 @@ from typing import Any, Callable, Dict, List, Sequence
 
 from ..engine import Engine, Event
 from .base import Context
-from .latches import Latch, LatchFile, holders, load
-from .status import HELD
+from .latches import Latch, LatchFile, holders, load, other_masters
+from .status import ELSEWHERE, HELD
 
 Log = Callable[[str, str], None]
 Report = Callable[[Dict[str, Any]], None]
@@ -29,6 +29,7 @@ class LatchKeeper:
         self.report = report
         self.restored: List[Latch] = []
         self.problems: List[str] = []  # what was wrong with the file at start
+        self.elsewhere: List[str] = []  # files of this node for other masters holding latches, until ~reset
 
     # -- start ---------------------------------------------------------------------------
     def restore(self, actions: Dict[str, Any], runners: Dict[str, Any], now: float) -> None:
@@ -36,6 +37,7 @@ class LatchKeeper:
         if self.file.path is None:
             return
         latches, self.problems = load(self.file.path, {n: bool(a.latch) for n, a in actions.items()})
+        self.elsewhere = other_masters(self.file.path)  # this master spelt otherwise? (logged by the node)
         for p in self.problems:
             self.log("error", p)
         for latch in latches:
@@ -84,6 +86,7 @@ class LatchKeeper:
                          "rules": [], "cause": "reset service", "latency_ms": None})
         self.restored = []
         self.problems = []  # the file is rewritten from the state now held
+        self.elsewhere = []  # acknowledged
         return n
 
     def status(self) -> Dict[str, str]:
@@ -95,4 +98,6 @@ class LatchKeeper:
         if errors:
             out["latch state error"] = "; ".join(errors)
         out["latch state file"] = self.file.path or "off (~state_file: false)"
+        if self.elsewhere:
+            out[ELSEWHERE] = ", ".join(self.elsewhere)
         return out

@@ -113,6 +113,28 @@ def _holds_latches(path: str) -> bool:
     return bool(latches) and not error
 
 
+def adopt_unkeyed(path: str, unkeyed: str) -> bool:
+    """Copy the state file an earlier version kept for any master (`NODE.latches.json`, which names
+    no master) to `path`, this master's, when `path` has none and it holds latches: a stop latched
+    before the upgrade survives it. Copied, not moved: were it this machine's default master's too,
+    that monitor keeps it (holding a stop twice is the safe error). True when copied."""
+    if os.path.exists(path) or not _holds_latches(unkeyed):
+        return False
+    try:
+        with open(unkeyed, "rb") as fh:
+            raw = read_at_most(fh, 1 << 20)
+        if "master" in json.loads(raw.decode("utf-8")):
+            return False  # written by this version for the default master: not ours
+        os.makedirs(os.path.dirname(path) or ".", exist_ok=True)
+        tmp = f"{path}.{os.getpid()}.tmp"
+        with open(tmp, "wb") as fh:
+            fh.write(raw)
+        os.replace(tmp, path)
+    except (OSError, ValueError, UnicodeDecodeError):
+        return False
+    return True
+
+
 def load(path: str, declared: Dict[str, bool]) -> Tuple[List[Latch], List[str]]:
     """The latches a previous run left (none if there is no file) and the problems found.
 
@@ -195,9 +217,10 @@ def _fallback(raw: bytes, declared: Dict[str, bool], why: str) -> Tuple[List[Lat
 class LatchFile:
     """Writes the latch state when it changes; `path` None turns persistence off."""
 
-    def __init__(self, path: Optional[str], spec_path: str = "") -> None:
+    def __init__(self, path: Optional[str], spec_path: str = "", master: str = "") -> None:
         self.path = path
         self.spec_path = spec_path
+        self.master = master  # the ROS_MASTER_URI it was written under, for people and `adopt_unkeyed`
         # latches of a previous run that this spec cannot hold (undeclared actions): written with
         # every state until ~reset clears them, so that another restart still knows of them
         self.kept: List[Latch] = []
@@ -213,7 +236,7 @@ class LatchFile:
         with self._lock:
             if state == self._last and not self.error:
                 return True
-            body = json.dumps({"format": FORMAT, "version": VERSION, "spec": self.spec_path,
+            body = json.dumps({"format": FORMAT, "version": VERSION, "spec": self.spec_path, "master": self.master,
                                "latched": [{"holder": l.holder, "actions": list(l.actions)} for l in state]},
                               indent=1)
             tmp = f"{self.path}.{os.getpid()}.tmp"
@@ -247,5 +270,5 @@ def holders(items: Iterable[Tuple[str, Iterable[str]]]) -> List[Latch]:
     return [Latch(h, tuple(a)) for h, a in items if tuple(a)]
 
 
-__all__: List[Any] = ["Latch", "LatchFile", "default_path", "holders", "load", "master_key", "other_masters",
+__all__: List[Any] = ["Latch", "LatchFile", "adopt_unkeyed", "default_path", "holders", "load", "master_key", "other_masters",
                       "undeclared"]

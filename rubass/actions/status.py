@@ -58,6 +58,7 @@ def unknown_reasons(spec: CheckedSpec, rule_key: str, topics: Dict[str, Dict[str
 # what holds the robot apart from the active behaviours: latched actions kept across a reload or a clock
 # jump, and those restored at start (actions/keeper.py)
 HELD = ("held over a reload or clock jump (until ~reset)", "latched at start (until ~reset)")
+ELSEWHERE = "latched under another master's name"  # actions/keeper.py: WARN until ~reset
 
 
 def build(spec: CheckedSpec, rules: Dict[str, Any], active: List[int], topics: Dict[str, Dict[str, Any]],
@@ -132,6 +133,11 @@ def build(spec: CheckedSpec, rules: Dict[str, Any], active: List[int], topics: D
         level = max(level, WARN)
         msg += (f" (LATCH PERSISTENCE OFF: ~state_file is false, so a latched stop ({', '.join(latched)}) will not "
                 f"survive a restart of the monitor; a private parameter stays on the master for later runs)")
+    if monitor.get(ELSEWHERE):  # this master spelt otherwise in ROS_MASTER_URI since the last run, maybe
+        level = max(level, WARN)
+        msg += (f" (LATCHED UNDER ANOTHER MASTER'S NAME: {monitor[ELSEWHERE]} holds a latched stop of this node; "
+                f"if that is this robot's master spelt otherwise, restart with ~state_file:= that file; ~reset "
+                f"acknowledges)")
     held = "; ".join(monitor[k] for k in HELD if monitor.get(k))
     if held:  # held by nothing the rules now say (a reload, a clock jump, a restart): only ~reset releases it
         level = max(level, WARN)

@@ -169,7 +169,8 @@ class Monitor(Reloading):
         self.outputs = Outputs()
         self.dispatcher = Dispatcher({}, self.outputs.event, _ros_now)
         self.overload = OverloadGuard(self.config.overload_actions, 1.0, _log, self.outputs.event)
-        self.keeper = LatchKeeper(LatchFile(self.config.state_file, self.config.spec), _log, self.outputs.event)
+        self.keeper = LatchKeeper(LatchFile(self.config.state_file, self.config.spec, rosgraph.get_master_uri()),
+                                  _log, self.outputs.event)
         self.error_guard = ErrorGuard(self.config.error_actions, _log, self.outputs.event)
         self.clock_jump = ClockJump(self.dispatcher, _log,
                                     lambda engine: self.keeper.save(engine, self.dispatcher.orphans, self._fail_safes()))

@@ -10,7 +10,7 @@ from typing import List, Optional
 import rosgraph
 import rospy
 
-from ..actions.latches import adopt_old_default, default_path, master_key, other_masters
+from ..actions.latches import adopt_old_default, adopt_unkeyed, default_path, master_key, other_masters
 from .latch_master import is_local
 from .monitor import ConfigError, Monitor
 from .params import HELP, ParamError, read_config, unknown_params
@@ -48,6 +48,11 @@ def main(argv: Optional[List[str]] = None) -> int:
         old = default_path(os.environ.get("ROS_HOME"), "/rubass_monitor")
         if adopt_old_default(state_file, old):
             rospy.logwarn("rubass: latch state %s moved to %s (the node's new default name)", old, state_file)
+    if master:  # an earlier version kept one file for any master: a stop latched before the upgrade survives it
+        unkeyed = default_path(os.environ.get("ROS_HOME"), rospy.get_name())
+        if adopt_unkeyed(state_file, unkeyed):
+            rospy.logwarn("rubass: latch state %s (kept by an earlier version for any master) copied to %s, "
+                          "this master's", unkeyed, state_file)
     try:
         config = read_config(lambda name, default: rospy.get_param("~" + name, default), state_file)
         if config.state_file == state_file:  # the default: a latch kept under another master's name is said
