@@ -29,7 +29,7 @@ def test_a_stamped_publish_stop_carries_the_current_time_unless_the_library_sets
     got = [r for r in rec if r["kind"] == "recv" and r["topic"] == "/sstop"]
     assert len(got) >= 10, got
     stamps = [sec(r["msg"]["header"]["stamp"]) for r in got]
-    assert all(abs(s - r["wall"]) < 0.5 for s, r in zip(stamps, got)), stamps[:3]
+    assert all(abs(s - r["wall"]) < 2.0 for s, r in zip(stamps, got)), stamps[:3]  # now, not 0 (1970)
     assert len(set(stamps)) == len(stamps), "each publication stamped anew"
     assert all(r["msg"]["twist"]["linear"]["x"] == 0.0 for r in got)
     fixed = [r["msg"]["header"] for r in rec if r["kind"] == "recv" and r["topic"] == "/fixed"]
