@@ -120,6 +120,10 @@ def crossings(expr: ast.Expr, value_of: Callable[[ast.Expr], Callable[[], Any]],
             windows.append((e.topic, e.window))
         if isinstance(e, ast.Binary) and e.op in _COMPARE and (time_dependent(e.left) or time_dependent(e.right)):
             diffs.append((duals.difference(e.left, e.right), _exact(e.left, e.right)))
+        elif isinstance(e, ast.Binary) and e.op == "/" and time_dependent(e.right):
+            # where the divisor is 0 the quotient is unknown (`1 s / age(…)` as a message arrives):
+            # looked at again just past that instant, so its own crossing is planned from there
+            diffs.append((duals.dual(e.right), _exact(e.right)))
         elif isinstance(e, ast.Call) and time_dependent(e):
             args = e.args
             if e.func in ("min", "max"):

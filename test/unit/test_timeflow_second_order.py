@@ -111,3 +111,12 @@ def test_an_infinite_curvature_moving_away_plans_nothing():
     assert step_to_zero(2.0, 1.0, math.nan) is None
     assert step_to_zero(2.0, 1.0, math.inf) is None
     assert step_to_zero(-2.0, 1.0, math.inf) is not None
+
+
+def test_a_quotient_by_an_age_that_is_0_as_its_message_arrives_is_followed_from_just_after():
+    """Re-sweep finding: `1 s * 1 s / age(topic /a) < 2 s` is unknown at the message (age 0), so no
+    crossing was planned and it started at the next tick (a whole second late at 1 Hz)."""
+    for cond, at in (("1 s * 1 s / age(topic /a) < 2 s", 1.5), ("1 / age(topic /a) < 2 Hz", 1.5),
+                     ("0.5 s / age(topic /a) < 1", 1.5)):
+        got = first_start(cond, until=5.0, arrival=1.0)
+        assert got is not None and at - 1e-9 <= got <= at + 1e-5, (cond, got)
