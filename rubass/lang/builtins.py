@@ -161,6 +161,13 @@ class BuiltinChecks:
         if self._path_problem(arg):  # type: ignore[attr-defined]
             return e, ANY
         array, elem = self._array_term(arg)
+        if e.func == "len" and elem:  # len(status[*].values) counts statuses: not what it seems to say
+            self.error(arg.span, f"len() counts the elements of an array: 'topic {arg.topic}{arg.path_text}' would "  # type: ignore[attr-defined]
+                                 f"count those of 'topic {array.topic}{array.path_text}' whatever "
+                                 f"'{ast.path_suffix(elem).lstrip('.')}' is; write len(topic {array.topic}"
+                                 f"{array.path_text}), or index one element: len(topic {arg.topic}"
+                                 f"{ast.path_suffix(array.path[:-1])}[0]{ast.path_suffix(elem)})")
+            return e, ANY
         ety = self._field_ty(arg, array=True, msg_ok=e.func == "len")  # type: ignore[attr-defined]
         out = ast.ArrayFn(e.func, array, elem, span=e.span)
         if e.func != "len" and ety.kind not in ("num", "any"):  # strings, conditions: as min("a", 1) says

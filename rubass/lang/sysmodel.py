@@ -109,7 +109,8 @@ def _index_beyond(registry: Registry, root: str, path: Tuple[ast.PathElem, ...])
                     return (f"'{where}{elem.text}' selects no element of {array} (a slice is clipped to "
                             "the array, so this one is always empty)"), past
                 if any(b is not None and not -n <= b <= n for b in (elem.start, elem.stop)):
-                    past = past or (f"'{where}{elem.text}' runs past the end of {array}; it is clipped to "
+                    side = "start" if any(b is not None and b < -n for b in (elem.start, elem.stop)) else "end"
+                    past = past or (f"'{where}{elem.text}' runs past the {side} of {array}; it is clipped to "
                                     f"'{where}[{chosen[0]}:{chosen[-1] + 1}]'")
             current = FieldDef(current.name, current.type)  # its element
         else:

@@ -200,6 +200,13 @@ class ExprChecker(BuiltinChecks):
         if not bad and sum(isinstance(p, ast.Slice) for p in e.path) > 1:
             self.error(e.span, "a field path can run over one array only: one '[*]' or '[A:B]'")
             return True
+        for p in e.path:  # [100:90], [-1:-3]: empty whatever the array's length
+            if isinstance(p, ast.Slice) and p.start is not None and p.stop is not None \
+                    and (p.start < 0) == (p.stop < 0) and p.start >= p.stop:
+                self.error(e.span, f"a slice '{p.text}' selects no element whatever the array's length: [A:B] takes "
+                                   f"elements A to B-1, so A must come before B"
+                                   + (f" (did you mean '[{p.stop}:{p.start}]'?)" if p.start != p.stop else ""))
+                return True
         return bool(bad)
 
     def _field_ty(self, e: ast.TopicRef, array: bool = False, msg_ok: bool = False) -> Ty:
@@ -216,7 +223,16 @@ class ExprChecker(BuiltinChecks):
         if info.warning:
             self.warn(e.span, info.warning)
         if array:
-            if info.kind != "array" and ast.slice_at(e.path) < 0:
+            at = ast.slice_at(e.path)
+            one = model.field(e.topic, e.path[:at] + (0,) + e.path[at + 1:]) if 0 <= at < len(e.path) - 1 else None
+            if one is not None and one.kind == "array":  # rows[*].v: an array in each element (one's is)
+                self.error(e.span, f"{where}: a field path runs over one array only, and "
+                                   f"'{ast.path_suffix(e.path[at + 1:]).lstrip('.')}' is an array in each element of "
+                                   f"'topic {e.topic}{ast.path_suffix(e.path[:at + 1])}'{' (' + one.why + ')' if one.why else ''}; "
+                                   f"index one element ('topic {e.topic}{ast.path_suffix(e.path[:at])}[0]"
+                                   f"{ast.path_suffix(e.path[at + 1:])}')")
+                return ANY
+            if info.kind != "array" and at < 0:
                 self.error(e.span, f"{where} is not an array{': ' + info.why if info.why else ''}")
                 return ANY
             kind = info.elem_kind if info.kind == "array" else info.kind
