@@ -191,7 +191,8 @@ class _Walk:
         v = array_fn(e.func, lambda: arr, e.elem, limits)()
         if v is not UNKNOWN or not isinstance(arr, (tuple, bytes)):
             return v  # a value, or no array (no message yet, a field error: the data-level reasons)
-        sliced = ast.slice_at(e.ref.path) >= 0
+        at = ast.slice_at(e.ref.path)
+        sliced = at >= 0 and e.ref.path[at] != ast.Slice()  # `[*]` is the whole array
         what = f"{e.ref.topic}{e.ref.path_text}"
         if not arr:
             full = self._length(e.ref.topic, e.ref.path[:ast.slice_at(e.ref.path)]) if sliced else None

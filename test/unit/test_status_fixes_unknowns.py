@@ -185,3 +185,11 @@ def test_a_reason_inside_a_quantifier_quotes_the_term_as_written_not_a_class_nam
     assert e.store.rules["a.r"] is UNKNOWN
     got = " ".join(why(e))
     assert "Binary" not in got and "division by zero: topic /a.data[*] / 0 is 1 / 0" in got, got
+
+
+def test_min_over_every_element_of_an_empty_array_says_array_not_slice():
+    """Re-sweep finding: `[*]` is the whole array, but the reason said 'of an empty slice'."""
+    e = engine("r: min(topic /diag.status[*].level) > 1;")
+    e.on_message("/diag", 1.0, {"status": []})
+    assert e.store.rules["a.r"] is UNKNOWN
+    assert why(e)[0].startswith("min(topic /diag.status[*].level) of an empty array"), why(e)
