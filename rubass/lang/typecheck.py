@@ -126,6 +126,10 @@ class ExprChecker(BuiltinChecks):
         if not math.isfinite(e.value):  # the parser read 1e999 as infinity
             self.error(e.span, f"the number '{e.text or '1e999'}' is too large (the largest is about 1.8e308)")
             return ast.Lit(0.0, span=e.span), ANY
+        if e.value == 0.0 and any(c in "123456789" for c in e.text.lower().split("e")[0]):  # 1e-999
+            self.error(e.span, f"the number '{e.text}' is too small: it would be read as 0 (the smallest is about "
+                               "5e-324)")
+            return ast.Lit(0.0, span=e.span), ANY
         if e.unit is None:
             return ast.Lit(e.value, span=e.span), BARE
         unit = UNITS.get(e.unit)

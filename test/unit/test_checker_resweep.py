@@ -79,3 +79,9 @@ def test_a_slice_before_the_start_runs_past_the_start(tmp_path):
     assert any("runs past the start" in w for _, w in warnings), warnings
     _, warnings = run(tmp_path, "min(topic /odom.covariance[30:40]) > -1", model=True)
     assert any("runs past the end" in w for _, w in warnings), warnings
+
+
+def test_a_number_too_small_for_a_float_is_an_error_not_a_silent_zero(tmp_path):
+    errors, _ = run(tmp_path, "topic /a.data > 1e-999 m")
+    assert errors == [(21, "the number '1e-999' is too small: it would be read as 0 (the smallest is about 5e-324)")]
+    assert run(tmp_path, "topic /a.data > 0.0 m or topic /a.data > 0e5 m or topic /a.data > 1e-300 m")[0] == []
