@@ -15,7 +15,7 @@ from rubass_experiments.command import register as register_experiments
 from .ros.model_command import add_source_options, build_model
 from .ros.libtypes import after_check, after_failed_check
 from .ros.model_command import register as register_model
-from .lang.errors import Diagnostic, counted
+from .lang.errors import Diagnostic, counted, in_text_order
 from .lang.source import SourceSet
 from .lang.sourcefile import read_source
 
@@ -36,15 +36,17 @@ def cmd_check(args: argparse.Namespace) -> int:
         try:
             checked = load_spec(path, args.actions, model=model)
         except SpecError as exc:
-            print(exc.render(), file=sys.stderr)
             lib_errors, warnings, lib_sources = after_failed_check(path, args.actions, model)
+            for d in in_text_order(exc.in_order() + warnings + lib_errors):  # the model's warnings in their place
+                known = exc.sources is not None and exc.sources.get(d.span.file) is not None
+                print(d.render(exc.sources if known else lib_sources), file=sys.stderr)
             # the summary counts every error printed above it: the spec's, and its libraries'
-            n = sum(d.severity == "error" for d in exc.diagnostics) + _print_diags(warnings + lib_errors, lib_sources)
+            n = sum(d.severity == "error" for d in exc.diagnostics + warnings + lib_errors)
             print(f"{path}: {counted(n, 'error')}", file=sys.stderr)
             status = 1
             continue
         errors, warnings = after_check(checked, model)
-        n = _print_diags(checked.warnings + warnings, checked.sources) + _print_diags(errors, checked.sources)
+        n = _print_diags(in_text_order(checked.warnings + warnings + errors), checked.sources)
         if errors or n:
             print(f"{path}: {counted(max(n, len(errors)), 'error')}", file=sys.stderr)
             status = 1

@@ -61,10 +61,15 @@ class SpecError(RubassError):
         """Errors and warnings by file (in the errors' order of files) and position."""
         if not self.warnings:
             return self.diagnostics
-        files: Dict[str, int] = {}
-        for d in self.diagnostics + self.warnings:
-            files.setdefault(d.span.file, len(files))
-        return sorted(self.diagnostics + self.warnings, key=lambda d: (files[d.span.file], d.span.line, d.span.col))
+        return in_text_order(self.diagnostics + self.warnings)
+
+
+def in_text_order(diags: Sequence[Diagnostic]) -> List[Diagnostic]:
+    """Diagnostics by file (files in the order they first come) and position in it."""
+    files: Dict[str, int] = {}
+    for d in diags:
+        files.setdefault(d.span.file, len(files))
+    return sorted(diags, key=lambda d: (files[d.span.file], d.span.line, d.span.col))
 
 
 def counted(n: int, noun: str) -> str:
