@@ -20,7 +20,7 @@ import rospy
 
 from ...actions.clamp import AXES, clamp_twist
 from .arbiter import take_seat
-from ...actions.base import ActionPlugin, Context
+from ...actions.base import ActionPlugin, Context, Skipped
 from ...actions.status import NOTHING_DONE, RESOLVED
 from .publish import ros_class
 
@@ -89,6 +89,8 @@ class LimitPlugin(ActionPlugin):
             self.seat.activate()
             reached = self._publish(self._current())
             self._due = False
+        if reached < 0:  # a higher-priority action owns the topic: nothing proved; retried, not counted
+            raise Skipped(f"{self.params['topic']} is held by a higher-priority action")
         if reached == 0:
             raise IOError(f"no node subscribes to {self.params['topic']}: the limited command reached no one; "
                           f"commands go on being published as they come")

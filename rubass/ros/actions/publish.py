@@ -9,7 +9,7 @@ import roslib.message
 import rospy
 
 from .arbiter import take_seat
-from ...actions.base import ActionPlugin, ActionSetupError, Context
+from ...actions.base import ActionPlugin, ActionSetupError, Context, Skipped
 from ...actions.status import NOTHING_DONE
 
 
@@ -92,7 +92,11 @@ class PublishPlugin(ActionPlugin):
     def start(self, ctx: Context) -> None:
         assert self.pub is not None
         self.seat.activate()
-        if self._publish(self.msg, self.stamp) and self.pub.get_num_connections() == 0:
+        if not self._publish(self.msg, self.stamp):
+            # a higher-priority action owns the topic: nothing sent, nothing proved; retried (it is
+            # this action's turn once that one releases; meanwhile a failed start stays shown)
+            raise Skipped(f"{self.params['topic']} is held by a higher-priority action")
+        if self.pub.get_num_connections() == 0:
             # not an error rospy would report: the message just went nowhere. A failure, so it is
             # logged, counted in /diagnostics and retried (0.05 s, 0.1 s, … then every 1 s); the
             # periodic publication also reaches a subscriber that connects later.
@@ -106,10 +110,11 @@ class PublishPlugin(ActionPlugin):
     def release(self, ctx: Context) -> Any:
         try:
             if self.release_msg is not None and self.pub is not None and self._publish(self.release_msg,
-                                                                                        self.release_stamp):
+                                                                                        self.release_stamp) \
+                    and self.pub.get_num_connections() > 0:
                 return None
-            # nothing published (no on_release, or a higher-priority action owns the topic): a
-            # failed start is not shown fixed by it
+            # nothing that reached anyone (no on_release, a higher-priority action owns the topic, no
+            # subscriber): a failed start is not shown fixed by it
             return NOTHING_DONE
         finally:
             self.seat.deactivate()  # after on_release: the next action on the topic is woken to publish
