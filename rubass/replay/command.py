@@ -7,7 +7,7 @@ import json
 import os
 import sys
 from contextlib import contextmanager
-from typing import Any, Iterable, Iterator, Set, Tuple
+from typing import Any, Iterable, Iterator, List, Sequence, Set, Tuple
 
 from ..lang import SpecError, load_spec
 from . import report
@@ -50,6 +50,38 @@ def _sampled_nodes(samples: Iterable[Tuple[float, str, Any]]) -> Set[str]:
     return out
 
 
+def bag_type_errors(spec: Any, spec_path: str, actions: Sequence[str], bag: Any, bag_path: str, info: Any,
+                    decode: Set[str], prog: str) -> List[str]:
+    """The errors of SPEC read against the recording's types, each a complete line to print: an array used
+    as a number, a wrong field path, a unit mismatch… at the spec's line, as `rubass check --bag` reports
+    them (issue 20.6); a field the recording's classes lack. Empty when the spec can read the recording.
+    `rubass replay` and `rubass report --bag` both refuse a recording with such errors."""
+    from ..ros.bag import BagError, message_classes
+    from ..ros.model_sources import bag_model
+    from ..ros.msgtypes import check_path
+
+    try:
+        classes = message_classes(bag, sorted(decode))
+    except BagError as exc:
+        return [f"{prog}: error: {exc}"]
+    try:  # the recording's types as a system model
+        load_spec(spec_path, list(actions), model=bag_model(bag_path))
+    except SpecError as exc:
+        return [exc.render()]
+    except BagError as exc:
+        return [f"{prog}: error: {exc}"]
+    errors = []
+    readers = [((t, p), owners) for t, paths in spec.field_readers(implicit=False).items() for p, owners in paths.items()]
+    for (topic, path), owners in sorted(readers, key=str):
+        cls = classes.get(resolve(topic))
+        problem = check_path(cls, path) if cls is not None else None
+        if problem:
+            field = "".join(f"[{p}]" if isinstance(p, int) else f".{p}" for p in path)
+            errors.append(f"{prog}: error: {' and '.join(owners)} reads {topic}{field}, but in "
+                          f"{info.types[resolve(topic)]}: {problem}")
+    return errors
+
+
 @contextmanager
 def _fewer_collections() -> Iterator[None]:
     """Python's cyclic garbage collector run less often: a replay allocates millions of
@@ -68,8 +100,7 @@ def run(args: argparse.Namespace) -> int:
     except SpecError as exc:
         print(exc.render(), file=sys.stderr)
         return 1
-    from ..ros.bag import BagError, message_classes, open_bag, read
-    from ..ros.msgtypes import check_path
+    from ..ros.bag import BagError, open_bag, read
 
     try:
         bag, info = open_bag(args.bag)
@@ -91,31 +122,7 @@ def run(args: argparse.Namespace) -> int:
                   "agents' /rubass/agent_samples); alive(), cpu() and memory() stay unknown", file=sys.stderr)
         present = [t for t in topic_map if t in info.types]
         decode: Set[str] = {t for t in present if any(spec.topics[n].needs_data for n in topic_map[t])}
-        try:
-            classes = message_classes(bag, sorted(decode))
-        except BagError as exc:
-            print(f"rubass replay: error: {exc}", file=sys.stderr)
-            return 1
-        try:  # the recording's types as a system model: an array used as a number, len() of a
-            # string… are errors at the spec's line, as `rubass check --bag` reports them (issue 20.6)
-            from ..ros.model_sources import bag_model
-
-            load_spec(args.spec, args.actions, model=bag_model(args.bag))
-        except SpecError as exc:
-            print(exc.render(), file=sys.stderr)
-            return 1
-        except BagError as exc:
-            print(f"rubass replay: error: {exc}", file=sys.stderr)
-            return 1
-        errors = []
-        readers = [((t, p), owners) for t, paths in spec.field_readers(implicit=False).items() for p, owners in paths.items()]
-        for (topic, path), owners in sorted(readers, key=str):
-            cls = classes.get(resolve(topic))
-            problem = check_path(cls, path) if cls is not None else None
-            if problem:
-                field = "".join(f"[{p}]" if isinstance(p, int) else f".{p}" for p in path)
-                errors.append(f"rubass replay: error: {' and '.join(owners)} reads {topic}{field}, but in "
-                              f"{info.types[resolve(topic)]}: {problem}")
+        errors = bag_type_errors(spec, args.spec, args.actions, bag, args.bag, info, decode, "rubass replay")
         if errors:
             print("\n".join(errors), file=sys.stderr)
             return 1

@@ -54,9 +54,13 @@ def run(args: argparse.Namespace) -> int:
             print(f"rubass report: error: {r.path} tests {r.spec.path}, not {args.spec}: its "
                   f"{len(r.outcomes)} test{'s are' if len(r.outcomes) != 1 else ' is'} not evidence for this spec and "
                   f"{'are' if len(r.outcomes) != 1 else 'is'} not counted (give the test files of {args.spec}, whose 'spec:' names it)", file=sys.stderr)
-    bags = [replay_bag(spec, path) for path in args.bag]
+    bags = [replay_bag(spec, path, actions=args.actions) for path in args.bag]
     for b in bags:
-        if b.error:
+        if b.type_errors:  # at the spec's line, as `rubass check --bag` prints them
+            print("\n".join(b.type_errors), file=sys.stderr)
+            print(f"rubass report: error: {b.path} not replayed: {args.spec} cannot read its types (above); the "
+                  f"page shows it as not replayed", file=sys.stderr)
+        elif b.error:
             print(f"rubass report: error: {b.error}", file=sys.stderr)
     ev = Evidence(spec, hazards, results, bags, reaction)
     build_matrix(ev)
@@ -91,7 +95,8 @@ def run(args: argparse.Namespace) -> int:
           + (f" ({untraced} rule{' traces' if untraced == 1 else 's trace'} to no hazard)" if untraced else "")
           + (f"; {len(foreign)} test file{'s' if len(foreign) != 1 else ''} of another spec not counted" if foreign
              else "")
-          + (f"; not run: {', '.join(r.path for r in results if r.error)}" if any(r.error for r in results) else ""))
+          + (f"; not run: {', '.join(r.path for r in results if r.error)}" if any(r.error for r in results) else "")
+          + (f"; not replayed: {', '.join(b.path for b in bags if b.error)}" if any(b.error for b in bags) else ""))
     if reaction is not None and reaction.developers:
         print(f"note: the monitor's reaction on the page is the developers' figures"
               f"{f' of {reaction.date}' if reaction.date else ''} (bench/README.md), not this machine's: run "

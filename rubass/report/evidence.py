@@ -39,6 +39,7 @@ class BagRun:
     events: List[Event] = field(default_factory=list)
     error: str = ""
     warnings: List[str] = field(default_factory=list)
+    type_errors: List[str] = field(default_factory=list)  # the spec against the recording's types, printed as is
 
 
 @dataclass
@@ -217,7 +218,7 @@ def _untraced_row(ev: Evidence, r: Any, users: List[Any]) -> Row:
 def covering(outcomes: List[Outcome], names: Sequence[str]) -> List[Outcome]:
     """The tests whose `covers` names one of `names`: the one meaning of "covered", shared with
     `rubass test --coverage` (a test that only happens to make a rule true covers nothing)."""
-    return [o for o in outcomes if set(names) & set(o.covers)]
+    return [o for o in outcomes if set(names) & set(o.counted_covers)]  # one that expects nothing proves nothing
 
 
 def _row(h: Hazard, rule: Optional[str], behaviours: List[str], ids: List[str], outcomes: List[Outcome],
@@ -237,8 +238,10 @@ def _failing(tests: List[Outcome]) -> List[str]:
     return [f"test '{o.name}' fails" for o in tests if not o.passed]
 
 
-def replay_bag(spec: CheckedSpec, path: str, rate: float = 50.0) -> BagRun:
-    """The spec over a recording, as `rubass replay` runs it."""
+def replay_bag(spec: CheckedSpec, path: str, rate: float = 50.0, actions: Sequence[str] = ()) -> BagRun:
+    """The spec over a recording, as `rubass replay` runs it; not replayed (`error`, `type_errors`) when the
+    spec cannot read the recording's types, as `rubass replay` and `rubass check --bag` refuse it."""
+    from ..replay.command import bag_type_errors
     from ..replay.run import replay
     from ..ros.bag import BagError, open_bag, read
 
@@ -259,6 +262,12 @@ def replay_bag(spec: CheckedSpec, path: str, rate: float = 50.0) -> BagRun:
         agent_topics = sorted(t for t in strings if t.endswith("/agent_samples"))
         decode = {t for t in present if any(spec.topics[n].needs_data for n in names[t])} | set(node_topics) | \
             set(agent_topics)
+        run.type_errors = bag_type_errors(spec, spec.path, actions, bag, path, info, decode, "rubass report")
+        if run.type_errors:
+            run.warnings = []
+            run.error = (f"not replayed: {os.path.basename(spec.path)} cannot read this recording's types "
+                         f"(as `rubass check --bag` and `rubass replay` say):")
+            return run
         stream: Any = ((t, name, msg) for t, topic, msg in read(bag, present + node_topics + agent_topics, decode)
                        for name in names.get(topic, (topic,)))
         try:

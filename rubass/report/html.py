@@ -84,10 +84,19 @@ def render(ev: Evidence) -> str:
                f"{f', {len(foreign)} file(s) of another spec not counted' if foreign else ''}</div>"
                f"<div class='card'><b class='{'fail' if gaps else 'pass'}'>{gaps}</b>gap{'s' if gaps != 1 else ''} in the matrix"
                f"{untraced_note}</div>"
-               f"<div class='card'>{_reaction_card(ev)}</div></div>")
+               f"<div class='card'>{_reaction_card(ev)}</div>{_bags_card(ev)}</div>")
     out += _matrix(ev), _rules(ev), _behaviours(ev), _tests(ev), _bags(ev)
     out.append("</body></html>")
     return "\n".join(out)
+
+
+def _bags_card(ev: Evidence) -> str:
+    """Recordings replayed, and, in red, those that could not be (unreadable, or types the spec cannot read)."""
+    if not ev.bags:
+        return ""
+    bad = sum(1 for b in ev.bags if b.error)
+    return (f"<div class='card'><b class='{'fail' if bad else 'pass'}'>{len(ev.bags) - bad} / {len(ev.bags)}</b>"
+            f"recordings replayed{f', <span class=fail>{bad} not replayed</span>' if bad else ''}</div>")
 
 
 def _reaction_card(ev: Evidence) -> str:
@@ -208,7 +217,7 @@ def _tests(ev: Evidence) -> str:
         for o in r.outcomes:
             verdict = "<span class='pass'>PASS</span>" if o.passed else "<span class='fail'>FAIL</span>"
             problems = f"<pre>{_e(chr(10).join(o.problems))}</pre>" if o.problems else ""
-            rows.append(f"<tr><td>{verdict}</td><td>{_e(o.name)}{problems}</td><td>{_list(o.covers)}</td>"
+            rows.append(f"<tr><td>{verdict}</td><td>{_e(o.name)}{problems}</td><td>{_list(o.covers)}{'' if o.proves else ' (not counted: it expects nothing)'}</td>"
                         f"<td>{o.duration:g} s</td></tr>")
         parts.append(_table(["result", "test", "covers", "simulated"], rows))
     cov = ev.coverage
@@ -233,7 +242,7 @@ def _bags(ev: Evidence) -> str:
     for run in ev.bags:
         parts.append(f"<h3><code>{_e(_shown(run.path))}</code></h3>")
         if run.error:
-            parts.append(f"<pre class='fail'>{_e(run.error)}</pre>")
+            parts.append(f"<pre class='fail'>{_e(chr(10).join([run.error] + run.type_errors))}</pre>")
             continue
         parts.append(f"<p>{run.duration:.3f} s, {run.messages} messages. Rules: red true, green false, grey "
                      f"unknown; behaviours: orange while active, ▼ at each start.</p>")
