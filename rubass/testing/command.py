@@ -34,7 +34,8 @@ def print_results(results: List[FileResult], out: TextIO, err: TextIO) -> None:
             continue
         print(f"{shown_path(r.path)} (spec {shown_path(r.spec_path)})", file=out)
         for o in r.outcomes:
-            covers = f"  [{', '.join(o.covers)}]" if o.covers else ""
+            covers = f"  [{', '.join(o.covers)}{'' if o.proves else ': not counted, it expects nothing'}]" \
+                if o.covers else ""
             print(f"  {'PASS' if o.passed else 'FAIL'}  {o.name}{covers}", file=out)
             for problem in o.problems:
                 print(f"    {problem}", file=out)

@@ -365,6 +365,9 @@ class _Reader:
             raise self.fail(e.at(kind), f"{kind} names a behaviour (name or number) or an action")
         out = Expect(kind, name, line)  # with a bad time it is kept (its name is still checked), at 0 s
         out.tolerance = times.get("tolerance")
+        if kind == "never" and "tolerance" in e:  # on active it widens from and to (docs/testing.md)
+            raise self.fail(e.at("tolerance"), "'tolerance' does not go with never: it has no instant to be "
+                                               "near (never holds over the whole test)")
         allowed = {"start": ("at",), "release": ("at",), "never": (), "active": ("from", "to")}[kind]
         for k in ("at", "from", "to"):
             if k in e and k not in allowed:

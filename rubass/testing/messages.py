@@ -129,6 +129,14 @@ def _nested_class(type_name: str) -> Any:
     return _DYNAMIC.get(type_name) or message_class(type_name)
 
 
+def _int_range(slot: str) -> Tuple[int, int]:
+    """The values an integer field holds: uint8 0 to 255, int8 -128 to 127 (byte is ROS 1's int8, char its
+    uint8), as genpy packs them."""
+    kind = {"byte": "int8", "char": "uint8"}.get(slot, slot)
+    bits = int(kind.lstrip("uint"))
+    return (0, 2 ** bits - 1) if kind.startswith("u") else (-2 ** (bits - 1), 2 ** (bits - 1) - 1)
+
+
 def _a(slot: str) -> str:
     """'an int8', 'a float64', 'a uint8': the type with its article."""
     return f"{'an' if slot[:1] in 'aeio' else 'a'} {slot}"
@@ -146,6 +154,9 @@ def _scalar(slot: str, value: Any, where: str) -> Any:
             value = int(value)
         if isinstance(value, bool) or not isinstance(value, int):
             raise MessageError(f"{where} is {_a(slot)}: {value!r} is not an integer")
+        low, high = _int_range(slot)
+        if not low <= value <= high:
+            raise MessageError(f"{where} is {_a(slot)}: {value} is out of range {low} to {high}")
         return value
     if slot == "bool":
         if value in (0, 1) and not isinstance(value, bool):

@@ -11,7 +11,7 @@ from ..lang import SpecError, load_spec
 from ..lang.model import CheckedSpec
 from .coverage import traced, unknown_covers
 from .declared import declared_model, per_test_models
-from .cases import TestFile
+from .cases import Case, TestFile
 from .format import read_test_file
 from .runner import Outcome, execute, prepare_all
 from .yamlpos import TestFileError
@@ -44,6 +44,8 @@ def run_file(path: str, extra_actions: Sequence[str] = ()) -> FileResult:
                 p = prepare_all(spec, c, path, result.warnings, errors)
                 if p is not None:
                     prepared.append(p)
+                    if not c.expects:
+                        result.warnings.append(_expects_nothing(c, path))
             result.warnings += _unknown_covers(spec, tf, path)
         if errors:
             rendered = _rendered(errors)
@@ -117,6 +119,13 @@ def _spec_error(path: str, why: str, exc: SpecError) -> str:
     text = "\n".join(shown + line[len(path):] if line.startswith(path + ":") else line
                      for line in exc.render().splitlines())
     return f"spec {shown} {why}:\n{text}"
+
+
+def _expects_nothing(case: Case, path: str) -> str:
+    """The warning for a test with no expectation: it runs and passes, but proves nothing, so its
+    `covers` count in no coverage (docs/testing.md)."""
+    covers = "; its covers do not count" if case.covers else ""
+    return f"{path}:{case.line}: warning: test '{case.name}' expects nothing, so it proves nothing{covers}"
 
 
 def _unknown_covers(spec: CheckedSpec, tf: TestFile, path: str) -> List[str]:

@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import io
 import json
+import math
 from dataclasses import dataclass, field
 from typing import Any, Dict, List, Optional, Set, Tuple
 
@@ -41,6 +42,12 @@ class Outcome:
     started: Set[int] = field(default_factory=set)
     duration: float = 0.0
     elapsed: float = 0.0
+    proves: bool = True  # False: it expects nothing (docs/testing.md), so its covers count in no coverage
+
+    @property
+    def counted_covers(self) -> List[str]:
+        """The covers that count as coverage: none for a test that expects nothing."""
+        return list(self.covers) if self.proves else []
 
 
 class _Sample:
@@ -122,21 +129,24 @@ def _stream(spec: CheckedSpec, case: Case, path: str, warnings: List[str],
         for name in names.get(topic, ()):
             out.append((EPOCH + time, 0, name, msg))
     state: Dict[str, Dict[str, Any]] = {}
-    nodes = {resolve(n): n for n in spec.nodes}  # as the monitor resolves them
+    # resolved -> every spelling of the node in the spec: the monitor samples each spelling (as it
+    # resolves them), so each gets the samples of the node, as each spelling of a topic gets its messages
+    nodes = spellings(spec.nodes)
     for s in sorted(case.nodes, key=lambda s: s.time):
-        node = s.node if s.node in spec.nodes else nodes.get(resolve(s.node))
-        if node is None:
+        node = resolve(s.node)
+        if node not in nodes:
             warnings.append(f"{path}:{s.line}: warning: the spec names no node {s.node}"
                             f"{did_you_mean(s.node, spec.nodes)}; its samples change nothing")
             continue
         if s.time > end:
             continue
-        prev = state.setdefault(node, {"alive": None, "cpu": None, "memory": None})
+        prev = state.setdefault(node, {"alive": None, "cpu": None, "memory": None})  # one node, any spelling
         for key, value in (("alive", s.alive), ("cpu", s.cpu), ("memory", s.memory)):
             if value is not UNSET:
                 prev[key] = value
-        data = json.dumps({"node": node, "time": EPOCH + s.time, **prev})
-        out.append((EPOCH + s.time, -1, NODE_TOPIC, _Sample(data)))
+        for name in nodes[node]:
+            data = json.dumps({"node": name, "time": EPOCH + s.time, **prev})
+            out.append((EPOCH + s.time, -1, NODE_TOPIC, _Sample(data)))
     out.sort(key=lambda x: (x[0], x[1]))  # samples before messages of the same instant
     return [(t, topic, msg) for t, _, topic, msg in out]
 
@@ -205,8 +215,42 @@ def _intervals(tl: List[Tuple[str, float]], end: float) -> List[Tuple[float, flo
     return out
 
 
-def _fmt(tl: List[Tuple[str, float]]) -> str:
-    return ", ".join(f"{k} at {t:.3f} s" for k, t in tl) or "no start or release"
+def _digits(tolerance: float) -> int:
+    """Decimals of a time in a failure: at least ms, and the tolerance's precision (0.4 ms: 4)."""
+    if tolerance <= 0:
+        return 6
+    return min(9, max(3, math.ceil(-math.log10(tolerance) - 1e-9)))
+
+
+def _shown_digits(actual: List[Tuple[str, float]], exps: List[Expect], tolerance: float) -> int:
+    """Decimals that show why the times differ: the tolerance's precision, the expected instants as
+    written (2.0012 s), and more while a pair outside its tolerance would print as within it
+    (2.001 s against 2.0021 s, tolerance 1 ms: 2.0010 and 2.0021)."""
+    tols = [e.tolerance if e.tolerance is not None else tolerance for e in exps]
+    d = max([_digits(min(tols, default=tolerance))] + [_places(e.at) for e in exps])
+    pairs = []
+    for kind in ("start", "release"):
+        times = sorted(t for k, t in actual if k == kind)
+        wanted = sorted((e.at, e.tolerance if e.tolerance is not None else tolerance) for e in exps if e.kind == kind)
+        pairs += [(t, w, tol) for t, (w, tol) in zip(times, wanted)]
+    while d < 9 and any(abs(t - w) > tol + 1e-9 and abs(round(t, d) - round(w, d)) <= tol + 1e-12
+                        for t, w, tol in pairs):
+        d += 1
+    return d
+
+
+def _places(t: float) -> int:
+    """The decimals an expected instant was written with (2.0012 s: 4), so that it prints as written."""
+    return next((d for d in range(3, 9) if abs(round(t, d) - t) < 1e-10), 9)
+
+
+def _tol(tolerance: float) -> str:
+    """A tolerance as a test author writes it: 1 ms, 0.4 ms, 2 s."""
+    return f"{tolerance:g} s" if tolerance >= 1 else f"{round(tolerance * 1000, 6):g} ms"
+
+
+def _fmt(tl: List[Tuple[str, float]], digits: int = 3) -> str:
+    return ", ".join(f"{k} at {t:.{digits}f} s" for k, t in tl) or "no start or release"
 
 
 @dataclass
@@ -262,7 +306,7 @@ def execute(p: Prepared) -> Outcome:
     # instant): the engine runs to the duration plus the largest tolerance, as an expectation is matched
     tol = max([case.tolerance] + [e.tolerance for e, _ in targets if e.tolerance is not None])
     _, events = replay(spec, stream, EPOCH, EPOCH + end + tol, TICK_RATE, [NODE_TOPIC] if spec.nodes else [])
-    out = Outcome(case.name, case.line, list(case.covers), duration=end)
+    out = Outcome(case.name, case.line, list(case.covers), duration=end, proves=bool(case.expects))
     out.events = [e for e in events if e.kind in ("start", "release", "rule")]
     out.rules_true = {e.rule for e in events if e.kind == "rule" and e.value is True}
     out.started = {e.behaviour for e in events if e.kind == "start"}
@@ -273,11 +317,19 @@ def execute(p: Prepared) -> Outcome:
     for target, exps in counted.items():
         actual = timeline(spec, events, target)
         if not _match(actual, exps, case.tolerance):
-            expected = sorted(((e.kind, e.at) for e in exps), key=lambda x: x[1])
+            tols = sorted({e.tolerance if e.tolerance is not None else case.tolerance for e in exps})
+            digits = _shown_digits(actual, exps, case.tolerance)
             lines = sorted({e.line for e in exps})
             where = f"line{'s' if len(lines) > 1 else ''} {', '.join(str(n) for n in lines)}"
-            out.problems.append(f"{resolver.label(target)} ({where}):\n      expected: {_fmt(expected)}\n"
-                                f"      actual:   {_fmt(actual)}")
+            if len(tols) == 1:  # one tolerance: said once
+                expected = _fmt(sorted(((e.kind, e.at) for e in exps), key=lambda x: x[1]), digits)
+                expected += f" (each ± {_tol(tols[0])})"
+            else:  # each expectation's own
+                expected = ", ".join(f"{e.kind} at {e.at:.{digits}f} s ± "
+                                     f"{_tol(e.tolerance if e.tolerance is not None else case.tolerance)}"
+                                     for e in sorted(exps, key=lambda e: e.at))
+            out.problems.append(f"{resolver.label(target)} ({where}):\n      expected: {expected}\n"
+                                f"      actual:   {_fmt(actual, digits)}")
     for exp, target in targets:
         tol = exp.tolerance if exp.tolerance is not None else case.tolerance
         actual = timeline(spec, events, target)
@@ -285,14 +337,15 @@ def execute(p: Prepared) -> Outcome:
             starts = [t for k, t in actual if k == "start"]
             if starts:
                 out.problems.append(f"{resolver.label(target)}: expected never to start (line {exp.line}), "
-                                    f"but: {_fmt(actual)}")
+                                    f"but: {_fmt(actual, _digits(case.tolerance))}")
         elif exp.kind == "active":
             spans = _intervals(actual, end)
             if not any(a <= exp.start + tol and b >= exp.end - tol for a, b, _ in spans):
-                shown = ", ".join(f"[{a:.3f}, {b:.3f}]" + (" (still active at the test's end)" if open_ else "")
+                d = _digits(tol)
+                shown = ", ".join(f"[{a:.{d}f}, {b:.{d}f}]" + (" (still active at the test's end)" if open_ else "")
                                   for a, b, open_ in spans) or "never"
                 out.problems.append(f"{resolver.label(target)}: expected active (line {exp.line}) throughout "
-                                    f"[{exp.start:.3f}, {exp.end:.3f}] s, but active: {shown}")
+                                    f"[{exp.start:.{d}f}, {exp.end:.{d}f}] s ± {_tol(tol)}, but active: {shown}")
     out.passed = not out.problems
     return out
 

@@ -110,7 +110,7 @@ def _word(word: str, field_dim: Any, field: str) -> List[Any]:
         return [GAP]
     m = _RAMP.fullmatch(word)
     if m:
-        a, b, n = float(m.group(1)), float(m.group(2)), int(m.group(3))
+        a, b, n = float(m.group(1)), float(m.group(2)), _count(word, int(m.group(3)))
         return [round(a + k * b, 12) for k in range(n)]  # 0.1 * 3 is 0.3 here, as the author meant
     m = _REPEAT.fullmatch(word)
     if m:
@@ -118,7 +118,17 @@ def _word(word: str, field_dim: Any, field: str) -> List[Any]:
     return [value(word, field_dim, field)]
 
 
+def _count(word: str, n: int) -> int:
+    """N of a word's xN: at least 1 (`0.6x0` would be no step at all, surely not what was meant)."""
+    if n < 1:
+        raise SeriesError(f"'{word}': N in xN must be at least 1 (`_xN` is N steps without a message)")
+    if n > _MAX_STEPS:
+        raise SeriesError(f"'{word}': more than {_MAX_STEPS} steps")
+    return n
+
+
 def _repeat(word: str, v: Any, n: int) -> List[Any]:
+    _count(word, n)
     if n > _MAX_STEPS:
         raise SeriesError(f"'{word}': more than {_MAX_STEPS} steps")
     return [v] * n
