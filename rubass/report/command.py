@@ -28,7 +28,8 @@ def register(sub: "argparse._SubParsersAction[argparse.ArgumentParser]") -> None
 def run(args: argparse.Namespace) -> int:
     from ..testing.results import run_file
     from .bench import BenchError, measured
-    from .evidence import Evidence, ReportError, build_matrix, read_hazards, replay_bag
+    from .evidence import Evidence, ReportError, build_matrix, replay_bag
+    from .hazards import HazardsError, read_hazards
     from .html import render
 
     try:
@@ -38,6 +39,10 @@ def run(args: argparse.Namespace) -> int:
         return 1
     try:
         hazards = read_hazards(args.hazards) if args.hazards else []
+    except HazardsError as exc:  # every error of the risk table, each at its place
+        print("\n".join(exc.lines), file=sys.stderr)
+        return 1
+    try:
         reaction = measured(args.bench)
     except (ReportError, BenchError) as exc:
         print(f"rubass report: error: {exc}", file=sys.stderr)

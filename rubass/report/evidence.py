@@ -6,7 +6,6 @@ import os
 from dataclasses import dataclass, field
 from typing import Any, Dict, List, Optional, Sequence, Set, Tuple
 
-import yaml
 
 from ..lang.errors import RubassError
 from ..engine import Event
@@ -18,17 +17,11 @@ from ..testing.coverage import Coverage, coverage
 from ..testing.results import FileResult
 from ..testing.runner import Outcome
 from .bench import Reaction
+from .hazards import Hazard, HazardsError, read_hazards  # noqa: F401 (the report's inputs, read here)
 
 
 class ReportError(RubassError):
     """An input of the report that cannot be used; the message says which and why."""
-
-
-@dataclass
-class Hazard:
-    id: str
-    title: str = ""
-    details: Dict[str, str] = field(default_factory=dict)  # severity, probability… from the risk table
 
 
 @dataclass
@@ -76,48 +69,6 @@ class Evidence:
 
     def same_spec(self, r: FileResult) -> bool:
         return r.spec is not None and os.path.realpath(r.spec.path) == os.path.realpath(self.spec.path)
-
-
-def read_hazards(path: str) -> List[Hazard]:
-    """A risk-assessment table: `hazards: [{id: H1, title: …, severity: …}, …]`, each id once."""
-    try:
-        with open(path, encoding="utf-8") as fh:
-            text = fh.read()
-        doc = yaml.safe_load(text)
-        lines = _item_lines(yaml.compose(text))
-    except OSError as exc:
-        raise ReportError(f"{path}: cannot read: {exc.strerror or exc}") from None
-    except UnicodeDecodeError:
-        raise ReportError(f"{path}: not a text file") from None
-    except yaml.YAMLError as exc:
-        raise ReportError(f"{path}: not valid YAML: {exc}") from None
-    items = doc.get("hazards") if isinstance(doc, dict) else None
-    if not isinstance(items, list):
-        raise ReportError(f"{path}: expected 'hazards:' with a list of {{id: …, title: …}}")
-    out: List[Hazard] = []
-    first: Dict[str, str] = {}
-    for i, h in enumerate(items):
-        where = f"{path}:{lines[i]}" if i < len(lines) else path
-        if not isinstance(h, dict) or not isinstance(h.get("id"), (str, int)):
-            raise ReportError(f"{where}: hazard {i + 1} needs an id")
-        hid = str(h["id"])
-        if hid in first:
-            raise ReportError(f"{where}: hazard {hid} is given twice; first at {first[hid]} (each id once: "
-                              f"the matrix would not know which row is meant)")
-        first[hid] = where
-        details = {str(k): str(v) for k, v in h.items() if k not in ("id", "title")}
-        out.append(Hazard(hid, str(h.get("title", "")), details))
-    return out
-
-
-def _item_lines(root: Any) -> List[int]:
-    """The 1-based line of each item of the `hazards:` list, from the composed YAML."""
-    if not isinstance(root, yaml.MappingNode):
-        return []
-    for key, value in root.value:
-        if getattr(key, "value", None) == "hazards" and isinstance(value, yaml.SequenceNode):
-            return [item.start_mark.line + 1 for item in value.value]
-    return []
 
 
 def attrs(owner: Any) -> Dict[str, Sequence[str]]:
