@@ -139,7 +139,8 @@ tests:
 """)
     tf = read_test_file(str(path))
     assert [e.line for e in tf.errors] == [8]
-    assert "does not fit sensor_msgs/LaserScan" in tf.errors[0].message
+    assert "/scan (sensor_msgs/LaserScan): header.seq is a uint32: 99999999999 is out of range 0 to 4294967295" \
+        in tf.errors[0].message  # the field, its type, the value and the range (a later fix's wording)
 
 
 def test_good_messages_still_run_and_pass(run):

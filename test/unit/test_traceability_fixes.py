@@ -129,7 +129,7 @@ def test_a_hazard_given_twice_in_the_risk_table_is_an_error_with_its_line(spec_p
     risk = write("risk.yaml", "hazards:\n  - {id: H1, title: Collision}\n  - id: H2\n    title: Tip-over\n"
                               "  - {id: H1, title: Again}\n")
     assert main(["report", spec_path, "--hazards", risk, "-o", str(tmp_path / "r.html")]) == 1
-    assert f"rubass report: error: {risk}:5: hazard H1 is given twice; first at {risk}:2" in capsys.readouterr().err
+    assert f"{risk}:5:10: error: hazard H1 is given twice; first at {risk}:2:10" in capsys.readouterr().err
 
 
 def test_one_gap_and_one_hazard_are_singular(spec_path, write, tmp_path, capsys):
