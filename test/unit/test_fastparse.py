@@ -14,7 +14,7 @@ import pytest
 from hypothesis import HealthCheck, example, given, settings
 from hypothesis import strategies as st
 
-from rubass.lang import SpecError, ast
+from rubass.lang import SpecError
 from rubass.lang.fastparse import parse_fast
 from rubass.lang.grammar import FUNCTIONS, KEYWORDS, parse_source
 from rubass.lang.source import Source
