@@ -193,7 +193,7 @@ class Engine:
         if isinstance(items, tuple) and len(items) == 1:  # the live case: one message, its own plan
             topic, msg = items[0]
             self._store_message(topic, now, msg, changed)
-            plan = self._topic_plans.get(topic)
+            plan = self._with_due(self._topic_plans.get(topic), now)
             if plan:
                 self._run(plan, events, changed)
             events += self._advance(now)
@@ -211,10 +211,28 @@ class Engine:
             for topic in key:
                 seeds.update(self._topic_plans.get(topic, ()))
             plan = self._batch_plans[key] = tuple(sorted(seeds))
+        plan = self._with_due(plan, now)
         if plan:
             self._run(plan, events, changed)
         events += self._advance(now)
         return self._ordered(events)
+
+    def _with_due(self, plan: Optional[Tuple[int, ...]], now: float) -> Optional[Tuple[int, ...]]:
+        """An input's plan with the nodes whose deadline falls at its very instant (and their users):
+        one evaluation at `now`, with the new data and every `for` due then. Apart, a rule using a
+        `for` due at t read its old value with t's message, and a `for` over it restarted
+        (test_for_reference: `(a < 1 or r0) for 1 s` fell for 1 s as r0 came true with a's message)."""
+        due: List[int] = []
+        while True:
+            at = self.next_deadline()
+            if at is None or at > now:
+                break
+            _, _, idx, _ = heapq.heappop(self._heap)
+            self._nodes[idx].fresh = True  # its operator's instant: evaluated whatever else changed
+            due.append(idx)
+        if not due:
+            return plan
+        return tuple(sorted(set(plan or ()) | set(self._plan(due))))
 
     def _store_message(self, topic: str, now: float, msg: Any, changed: Set[Any]) -> None:
         store = self.store
@@ -257,7 +275,7 @@ class Engine:
         """A sample of a node: alive True/False/UNKNOWN, cpu share of a core, memory bytes."""
         events = self._advance(now, inclusive=False)
         self.store.nodes[node] = {"alive": alive, "cpu": cpu, "memory": memory}
-        plan = self._node_plans.get(node)
+        plan = self._with_due(self._node_plans.get(node), now)
         if plan:
             self._run(plan, events, _NO_FIELDS)
         events += self._advance(now)
