@@ -37,7 +37,11 @@ class LatchKeeper:
         if self.file.path is None:
             return
         latches, self.problems = load(self.file.path, {n: bool(a.latch) for n, a in actions.items()})
-        self.elsewhere = other_masters(self.file.path)  # this master spelt otherwise? (logged by the node)
+        self.elsewhere = other_masters(self.file.path)  # this master spelt otherwise? WARN until ~reset
+        for other in self.elsewhere:
+            self.log("warn", f"{other} holds a latched stop of this node under another master's name; this run's "
+                             f"state file {self.file.path} holds none. If that is this robot's master spelt "
+                             f"otherwise, restart with the old spelling or ~state_file:={other} (docs/actions.md)")
         for p in self.problems:
             self.log("error", p)
         for latch in latches:

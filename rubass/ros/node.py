@@ -10,7 +10,7 @@ from typing import List, Optional
 import rosgraph
 import rospy
 
-from ..actions.latches import adopt_old_default, adopt_unkeyed, default_path, master_key, other_masters
+from ..actions.latches import adopt_old_default, adopt_unkeyed, default_path, master_key
 from .latch_master import is_local
 from .monitor import ConfigError, Monitor
 from .params import HELP, ParamError, read_config, unknown_params
@@ -55,12 +55,6 @@ def main(argv: Optional[List[str]] = None) -> int:
                           "this master's", unkeyed, state_file)
     try:
         config = read_config(lambda name, default: rospy.get_param("~" + name, default), state_file)
-        if config.state_file == state_file:  # the default: a latch kept under another master's name is said
-            for other in other_masters(state_file):
-                rospy.logwarn("rubass: %s holds a latched stop of this node under another master's name; this "
-                              "run's state file (ROS_MASTER_URI %s) is %s and holds none. If that is this robot's "
-                              "master spelt otherwise, restart with the old spelling or ~state_file:=%s "
-                              "(docs/actions.md)", other, rosgraph.get_master_uri(), state_file, other)
         monitor = Monitor(config)
         monitor.setup()
     except (ParamError, ConfigError) as exc:
