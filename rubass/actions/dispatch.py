@@ -9,6 +9,7 @@ from typing import Any, Callable, Dict, List, Optional
 
 from ..engine import Engine, Event
 from ..engine.loop import Message, NodeSample
+from ..lang.fmt import format_attrs
 from ..lang.model import CheckedBehaviour
 from .base import Context
 from .runner import ActionRunner
@@ -60,9 +61,10 @@ class Dispatcher:
             self._keys_for, self._keys = spec, self.keys(spec.behaviours)
         return self._keys
 
-    def send(self, kind: str, b: CheckedBehaviour, ctx: Context) -> None:
+    def send(self, kind: str, b: CheckedBehaviour, ctx: Context,
+             runners: Optional[Dict[str, ActionRunner]] = None) -> None:
         for bound in b.actions:
-            runner = self.runners.get(bound.name)
+            runner = (self.runners if runners is None else runners).get(bound.name)
             if runner is not None:
                 runner.submit(kind, Context(ctx.behaviour, ctx.line, ctx.rules, bound.args, ctx.time, ctx.key))
 
@@ -95,13 +97,15 @@ class Dispatcher:
             record.update(witness.as_json())
             why = "; ".join([f"true: {', '.join(witness.rules)}"] * bool(witness.rules)
                             + [r.text() for r in witness.readings])
-            who = witness.name or f"behaviour {e.behaviour}"
+            who = (witness.name or f"behaviour {e.behaviour}") + (f" {format_attrs(b.attrs)}" if b.attrs else "")
             self.last_start = f"{who} at {e.time:.3f} s" + (f": {why}" if why else "")
         self.report(record)
 
-    def release(self, b: CheckedBehaviour, key: Any, now: float) -> None:
-        """Release a behaviour's actions outside an engine event (reload, reset, shutdown)."""
-        self.send("release", b, Context(b.index, b.span.line, (), (), now, key))
+    def release(self, b: CheckedBehaviour, key: Any, now: float,
+                runners: Optional[Dict[str, ActionRunner]] = None) -> None:
+        """Release a behaviour's actions outside an engine event (reload, reset, shutdown); `runners`
+        instead of the dispatcher's own (a reload: the new ones, and the old of actions gone)."""
+        self.send("release", b, Context(b.index, b.span.line, (), (), now, key), runners)
 
     def release_orphans(self, now: float) -> None:
         """Release latched actions of behaviours that a reload removed (called by ~reset)."""

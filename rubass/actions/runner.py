@@ -10,7 +10,7 @@ import collections
 import threading
 import time
 import weakref
-from typing import Any, Callable, Deque, Dict, Optional, Set, Tuple
+from typing import AbstractSet, Any, Callable, Deque, Dict, Optional, Set, Tuple
 
 from .base import ActionPlugin, ActionStats, Context, Skipped
 from .status import NOTHING_DONE, RESOLVED
@@ -132,10 +132,11 @@ class ActionRunner:
         except Exception as exc:  # noqa: BLE001 - a plugin's failure must never reach the engine
             self.log("error", f"action '{self.plugin.name}' claim failed: {exc.__class__.__name__}: {exc}")
 
-    def adopt(self, old: "ActionRunner") -> None:
+    def adopt(self, old: "ActionRunner", leaving: AbstractSet[Any] = frozenset()) -> None:
         """Take over what the runner this one replaces (same action name, a reload changed its
         definition) holds: its holders stay holders and the action starts at once here, so a
-        latched 20 Hz stop goes on across the reload (issue 13)."""
+        latched 20 Hz stop goes on across the reload (issue 13). `leaving`: the keys of behaviours the
+        reload releases next (a per-behaviour plugin, a log, logs no start of theirs)."""
         with old._cond:
             held = dict(old._held)
         if not held:
@@ -146,7 +147,7 @@ class ActionRunner:
                 if ident not in self._active:
                     self._active.add(ident)
                     self._held[ident] = ctx
-                    if self.plugin.per_behaviour or first:
+                    if (ident[0] not in leaving) if self.plugin.per_behaviour else first:
                         self._queue.append(("start", ctx))
                         first = False
             self.plugin.active = True

@@ -9,6 +9,7 @@ from typing import Any, Dict, List, Optional, Sequence, Tuple
 
 from ..lang import ast
 from ..lang.errors import counted
+from ..lang.fmt import format_attrs
 from ..lang.model import CheckedSpec
 
 OK, WARN, ERROR = 0, 1, 2  # DiagnosticStatus levels
@@ -61,6 +62,13 @@ HELD = ("held over a reload or clock jump (until ~reset)", "latched at start (un
 ELSEWHERE = "latched under another master's name"  # actions/keeper.py: WARN until ~reset
 
 
+def _behaviour(spec: CheckedSpec, index: int) -> str:
+    """An active behaviour as /diagnostics lists it: its number, and its name and attributes (§14, §15)."""
+    b = spec.behaviours[index - 1] if 0 < index <= len(spec.behaviours) else None
+    extra = " ".join(x for x in (b.name, format_attrs(b.attrs)) if x) if b is not None else ""
+    return f"{index} ({extra})" if extra else str(index)
+
+
 def build(spec: CheckedSpec, rules: Dict[str, Any], active: List[int], topics: Dict[str, Dict[str, Any]],
           nodes: Dict[str, Dict[str, Any]], field_errors: Dict[Tuple[str, str], str],
           monitor: Dict[str, Any], failing: Sequence[Tuple[str, str]] = (),
@@ -70,6 +78,7 @@ def build(spec: CheckedSpec, rules: Dict[str, Any], active: List[int], topics: D
     `computed`: rule -> why its expression is unknown from values that came (engine/unknowns.py)."""
     out: List[Entry] = []
     by_entity: Dict[str, List[str]] = {}
+    attrs = {r.key: r.attrs for r in spec.rules}
     for r in spec.rules:
         by_entity.setdefault(r.entity, []).append(r.key)
     for entity, keys in by_entity.items():
@@ -78,6 +87,8 @@ def build(spec: CheckedSpec, rules: Dict[str, Any], active: List[int], topics: D
         for key in keys:
             v = rules.get(key)
             values.append((key.split(".", 1)[1], _text(v)))
+            if attrs.get(key):  # §15: its traceability, beside its value
+                values.append((f"{key.split('.', 1)[1]} attributes", format_attrs(attrs[key])))
             reasons = unknown_reasons(spec, key, topics, nodes, field_errors)
             # a field it cannot read is an error whatever its value (`false and unknown` is false)
             errors += [r for r in reasons if "reads" in r or "deserialise" in r]
@@ -101,7 +112,7 @@ def build(spec: CheckedSpec, rules: Dict[str, Any], active: List[int], topics: D
             level, msg = OK, "all rules false"
         out.append(Entry(f"rubass: {entity}", level, msg, values))
     mvalues = [(k, str(v)) for k, v in monitor.items()]
-    mvalues.append(("active behaviours", ", ".join(str(i) for i in active) or "none"))
+    mvalues.append(("active behaviours", ", ".join(_behaviour(spec, i) for i in active) or "none"))
     level = ERROR if monitor.get("last reload error") or failing else OK
     if monitor.get("latch state error"):  # a latched stop may not survive a restart, or one was restored blind
         level = ERROR

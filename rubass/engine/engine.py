@@ -15,6 +15,7 @@ import math
 from typing import AbstractSet, Any, Dict, FrozenSet, Iterable, List, Optional, Set, Tuple
 
 from ..lang import ast
+from ..lang.fmt import format_expr
 from ..lang.model import CheckedBehaviour, CheckedSpec
 from .evaluate import Compiled, Compiler
 from .explain import Explainer, Witness
@@ -441,17 +442,21 @@ class Engine:
             elif prev is not None and _same_ops(prev, node):  # edited: its `for`/`within`/`latch` keep
                 self._take_ops(prev, node)  # their history, so an edit that still holds releases nothing
         old_behaviours = {n.behaviour.identity: n for n in old._nodes if n.behaviour}
+        new_ones: List[_Node] = []
         for node in self._nodes:
             if not node.behaviour:
                 continue
             prev = old_behaviours.pop(node.behaviour.identity, None)
-            if prev is not None:
+            if prev is None:
+                new_ones.append(node)
+            else:
                 if prev.behaviour.signature == node.behaviour.signature or _same_ops(prev, node):  # type: ignore[union-attr]
                     self._take_ops(prev, node)
                 node.active, node.value = prev.active, prev.value
                 if node.active:
                     for a in node.actions:
                         self._holders.setdefault(a, set()).add(node.key)
+        _take_condition_history(self, new_ones, list(old_behaviours.values()))
         for action, holders in old._holders.items():
             outside = {h for h in holders if not h.startswith("b:")}
             if outside:
@@ -555,6 +560,23 @@ class Engine:
 _ABSENT = object()  # a rule not evaluated yet
 _INSTANT_OPS = (ForOp, WithinOp, LatchOp)  # operators whose value moves only at inputs and deadlines
 _NO_FIELDS: FrozenSet[int] = frozenset()  # a tick, a deadline, a node sample: no field changed
+
+
+def _take_condition_history(engine: Engine, new_ones: List[_Node], gone: List[_Node]) -> None:
+    """A behaviour new to this spec whose condition reads as one the old spec's behaviours no longer
+    have (renamed, its actions changed): its `for`/`within`/`latch` keep that one's history, so a
+    stop that held goes on (it starts at once, and the old one is released after it), not a `for`
+    time later, and a `within`'s minimum hold is not cut short by a rename."""
+    if not new_ones or not gone:
+        return
+    by_text: Dict[str, _Node] = {}
+    for prev in gone:
+        if prev.compiled.ops:
+            by_text.setdefault(format_expr(prev.behaviour.cond), prev)  # type: ignore[union-attr]
+    for node in new_ones:
+        prev = by_text.get(format_expr(node.behaviour.cond)) if node.compiled.ops else None  # type: ignore[union-attr]
+        if prev is not None and _same_ops(prev, node):
+            engine._take_ops(prev, node)
 
 
 def _same_ops(a: _Node, b: _Node) -> bool:

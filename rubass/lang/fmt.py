@@ -3,7 +3,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import replace
-from typing import Dict, List, Optional, Tuple
+from typing import Dict, List, Mapping, Optional, Sequence, Tuple
 
 from . import ast
 
@@ -227,6 +227,11 @@ def format_spec(spec: ast.Spec, text: Optional[str] = None) -> str:
     if com.footer.get(-1):
         out.extend(([""] if out else []) + com.footer[-1])
     return "\n".join(out) + "\n" if out else ""
+
+
+def format_attrs(attrs: Mapping[str, Sequence[str]]) -> str:
+    """Checked attributes as written (`@id("B-W") @hazard("H1", "H2")`), for /diagnostics."""
+    return " ".join(f"@{name}({', '.join(_quote(x) for x in args)})" for name, args in attrs.items())
 
 
 def _attrs(attrs: Tuple[ast.Attr, ...]) -> List[str]:

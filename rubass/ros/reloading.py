@@ -196,20 +196,25 @@ class Reloading:
         self._on_events(old.advance(now), "deadline")  # what fell due up to the swap, under the old rules
         events = new.adopt(old, now)
         old_keys = self.dispatcher.keys_of(old.spec)
+        old_runners = self.dispatcher.runners
+        leaving = {old_keys[o.checked.index] for o in new.orphans if not o.checked.latched}
+        for name, runner in runners.items():  # actions are carried across any reload by name
+            prev = old_runners.get(name)
+            if prev is not None and prev is not runner:
+                runner.adopt(prev, leaving)
+        self.dispatcher.runners = runners
+        self.loop.engine = new  # type: ignore[union-attr]
+        self._on_events(events, "reload")  # the latch state is written before a latched start is dispatched
+        # Then what the new rules no longer hold: after their starts, so that an action a new (renamed,
+        # edited) behaviour holds too is never released in between (its board would read "R" then "S").
+        gone = {**old_runners, **runners}  # an action no library defines any more: its old runner releases it
         for orphan in new.orphans:
             b = orphan.checked
             if b.latched:
                 self.dispatcher.orphans.append((b, old_keys[b.index]))
             else:
-                self.dispatcher.release(b, old_keys[b.index], now)
+                self.dispatcher.release(b, old_keys[b.index], now, gone)
                 self.dispatcher.report_event(Event(now, "release", b.index), b, (), "reload")  # pairs its start
-        for name, runner in runners.items():  # actions are carried across any reload by name
-            prev = self.dispatcher.runners.get(name)
-            if prev is not None and prev is not runner:
-                runner.adopt(prev)
-        self.dispatcher.runners = runners
-        self.loop.engine = new  # type: ignore[union-attr]
-        self._on_events(events, "reload")  # the latch state is written before a latched start is dispatched
         self.keeper.save(new, self.dispatcher.orphans, self._fail_safes())
 
 

@@ -1,0 +1,153 @@
+"""A reload that renames a behaviour, or changes its actions, while its stop is on: the stop goes on.
+
+Found by an acceptance sweep: an unnamed behaviour given one more action (or a renamed one) was a
+behaviour the reload removed plus a new one, and the old one's release reached the serial board
+before the new one's start ("R" then "S" while the speed was still over the limit); a renamed
+behaviour's `for` counted again from the reload (a stop a `for` time late), and a renamed
+`within`'s minimum hold was cut short at the reload."""
+import os
+
+import pytest
+
+pytest.importorskip("rospy")
+
+from rubass.actions.base import ActionPlugin  # noqa: E402
+from rubass.actions.dispatch import Dispatcher  # noqa: E402
+from rubass.actions.runner import ActionRunner  # noqa: E402
+from rubass.engine import Engine  # noqa: E402
+from rubass.lang import check_text  # noqa: E402
+from rubass.lang.library import ActionDef  # noqa: E402
+from rubass.ros import reloading  # noqa: E402
+
+from conftest import ROOT  # noqa: E402
+
+LIB = os.path.join(ROOT, "docs", "examples", "actions.yaml")
+HEAD = "action primitive board_stop, warn;\nentity e { rules: fast: topic /v.data > 0.5; }\n"
+
+
+def spec(text):
+    return check_text(HEAD + text, os.path.join(ROOT, "s.rbs"), [LIB])
+
+
+class Board(ActionPlugin):
+    """What a serial board would read: S on start, R on release."""
+
+    def __init__(self, name, per_behaviour=False):
+        super().__init__(ActionDef(name, "fake:Fake", {}))
+        self.per_behaviour = per_behaviour
+
+
+def phases(runner):
+    return [kind for kind, _ in runner._queue]  # what the runner's thread would send, in order
+
+
+class Monitor(reloading.Reloading):
+    """The real swap, dispatcher and runners (their threads not started: their queues are read)."""
+
+    def __init__(self, engine, runners):
+        self.loop = type("Loop", (), {"engine": engine})()
+        self.dispatcher = Dispatcher(runners, lambda record: self.records.append(record), lambda: 0.0)
+        self.keeper = type("K", (), {"save": lambda *a: None})()
+        self.records = []
+
+    def _on_events(self, events, cause):
+        self.dispatcher.handle(self.loop.engine, events, cause)
+
+    def _fail_safes(self):
+        return []
+
+
+def run_to(engine, monitor, t):
+    monitor._on_events(engine.advance(t), "deadline")
+
+
+def swap(monitor, monkeypatch, new_text, t, runners):
+    monkeypatch.setattr(reloading, "ros_now", lambda: t)
+    old = monitor.loop.engine
+    new = Engine(spec(new_text), t)
+    monitor._swap(old, new, new.spec, runners)
+    return new
+
+
+def start(text, runners, messages):
+    engine = Engine(spec(text), 0.0)
+    engine.evaluate_all(0.0)
+    monitor = Monitor(engine, runners)
+    for t, v in messages:
+        monitor._on_events(engine.on_message("/v", t, {"data": v}), "message")
+    return engine, monitor
+
+
+@pytest.mark.parametrize("new_text", [
+    "if (e.fast) then { board_stop; warn; }\n",  # unnamed, one more action
+    "halt: if (e.fast) then { board_stop; }\n",  # named now
+])
+def test_an_edit_that_makes_an_active_stop_another_behaviour_never_releases_the_board(monkeypatch, new_text):
+    board, warn = ActionRunner(Board("board_stop"), print), ActionRunner(Board("warn", True), print)
+    runners = {"board_stop": board, "warn": warn}
+    _, monitor = start("if (e.fast) then { board_stop; }\n", runners, [(1.0, 0.6)])
+    assert phases(board) == ["start"]
+    new = swap(monitor, monkeypatch, new_text, 2.0, runners)
+    assert new.active_behaviours() == [1]
+    assert phases(board) == ["start"], "the board read R then S at the reload, with the speed still over"
+    assert board.active
+    kinds = [(r["event"], r.get("name", "")) for r in monitor.records]
+    assert kinds[-2:] == [("start", new.spec.behaviours[0].name), ("release", "")]  # the new holds it first
+    monitor._on_events(new.on_message("/v", 3.0, {"data": 0.0}), "message")
+    assert phases(board) == ["start", "release"] and not board.active
+
+
+def test_a_renamed_behaviour_whose_action_changed_definition_still_goes_on(monkeypatch):
+    old_board = ActionRunner(Board("board_stop"), print)
+    _, monitor = start("bstop: if (e.fast) then { board_stop; }\n", {"board_stop": old_board}, [(1.0, 0.6)])
+    new_board = ActionRunner(Board("board_stop"), print)  # a reload that also changed its library entry
+    swap(monitor, monkeypatch, "halt: if (e.fast) then { board_stop; }\n", 2.0, {"board_stop": new_board})
+    assert phases(new_board) == ["start"] and new_board.active  # the new definition takes over, once
+    assert phases(old_board) == ["start"]  # the old one is not released before the new one starts
+
+
+def test_a_behaviour_that_goes_is_still_released_also_when_its_action_went_with_it(monkeypatch):
+    board, warn = ActionRunner(Board("board_stop"), print), ActionRunner(Board("warn", True), print)
+    _, monitor = start("if (e.fast) then { board_stop; warn; }\n", {"board_stop": board, "warn": warn}, [(1.0, 0.6)])
+    swap(monitor, monkeypatch, "if (e.fast) then { warn; }\n", 2.0, {"warn": warn})
+    assert phases(board) == ["start", "release"], "the old runner of an action no spec names releases it"
+    assert phases(warn) == ["start", "start", "release"]  # a log: the old behaviour's release, the new's start
+
+
+def test_a_log_action_whose_definition_changed_logs_no_start_for_a_behaviour_the_reload_removes(monkeypatch):
+    warn = ActionRunner(Board("warn", True), print)
+    _, monitor = start("if (e.fast) then { warn; }\n", {"warn": warn}, [(1.0, 0.6)])
+    new_warn = ActionRunner(Board("warn", True), print)
+    swap(monitor, monkeypatch, "slow: if (topic /v.data > 9) then { warn; }\n", 2.0, {"warn": new_warn})
+    assert phases(new_warn) == ["release"]
+
+
+def test_a_renamed_behaviour_keeps_its_for_count(monkeypatch):
+    old_text = "bstop: if (e.fast for 2 s) then { board_stop; }\n"
+    board = ActionRunner(Board("board_stop"), print)
+    old, monitor = start(old_text, {"board_stop": board}, [(1.0, 0.6)])
+    new = swap(monitor, monkeypatch, old_text.replace("bstop", "overspeed"), 1.5, {"board_stop": board})
+    assert new.active_behaviours() == []
+    assert new.next_deadline() == pytest.approx(3.0)  # not 3.5: the count since 1.0 is kept
+    run_to(new, monitor, 3.0)
+    assert new.active_behaviours() == [1] and phases(board) == ["start"]
+
+
+def test_a_renamed_behaviour_keeps_its_within_hold(monkeypatch):
+    old_text = "bw: if (e.fast within 2 s) then { board_stop; }\n"
+    board = ActionRunner(Board("board_stop"), print)
+    _, monitor = start(old_text, {"board_stop": board}, [(1.0, 0.6), (1.5, 0.0)])
+    new = swap(monitor, monkeypatch, old_text.replace("bw:", "hold_w:"), 2.0, {"board_stop": board})
+    assert new.active_behaviours() == [1], "the minimum hold was cut short by a rename"
+    assert phases(board) == ["start"]
+    run_to(new, monitor, 3.49)
+    assert new.active_behaviours() == [1]
+    run_to(new, monitor, 3.5)
+    assert new.active_behaviours() == [] and phases(board) == ["start", "release"]
+
+
+def test_a_new_behaviour_with_another_condition_counts_from_the_reload(monkeypatch):
+    board = ActionRunner(Board("board_stop"), print)
+    _, monitor = start("bstop: if (e.fast for 2 s) then { board_stop; }\n", {"board_stop": board}, [(1.0, 0.6)])
+    new = swap(monitor, monkeypatch, "other: if (e.fast for 3 s) then { board_stop; }\n", 1.5, {"board_stop": board})
+    assert new.next_deadline() == pytest.approx(4.5)  # another condition: no history taken
