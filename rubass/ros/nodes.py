@@ -162,6 +162,7 @@ class NodeSampler:
         self._uris: Dict[str, str] = {}
         self._pids: Dict[str, int] = {}  # last pid seen per node, to recognise it without the master
         self._looked_up: Dict[str, float] = {}  # monotonic time the master last gave each node's URI
+        self._unregistered: Set[str] = set()  # nodes the master's last answer did not know (and never seen)
         self._local = _local_addresses()
         self._hosts: Dict[str, bool] = {}
         self.port_owners = PortOwners()  # does the pid a node gives own its XML-RPC port (pidcheck.py)
@@ -283,12 +284,17 @@ class NodeSampler:
         if code == 1:
             self._uris[name] = uri
             self._looked_up[name] = time.monotonic()
+            self._unregistered.discard(name)
         else:
             uri = self._uris.get(name)
             if uri is None:
-                if code == -2:
-                    return UNKNOWN, None, f"the master cannot be reached ({msg}) and the node was never seen"
-                return False, None, "not registered with the master"
+                if code != -2:
+                    self._unregistered.add(name)
+                    return False, None, "not registered with the master"
+                if name in self._unregistered:  # still so: no node can register while the master is away
+                    return False, None, (f"not registered with the master at its last answer; the master cannot "
+                                         f"be reached now ({msg}), and no node registers without it")
+                return UNKNOWN, None, f"the master cannot be reached ({msg}) and the node was never seen"
             # the master is down, or restarted and does not know the node (rospy nodes do not
             # re-register): ask the node where it was; alive only if it is the same process
             note = " (the master cannot be reached)" if code == -2 else " (not registered with the master: restarted?)"

@@ -317,3 +317,30 @@ def test_a_payload_that_does_not_match_its_type_is_unknown_and_logged_once():
         watcher._callback(_raw(b"\x01\x02\x03", "std_msgs/Float64", Float64._md5sum, Float64._full_text), state)
     assert all(g[2] is UNKNOWN for g in got) and len(got) == 1000
     assert len([t for t in logs if "cannot deserialise" in t]) == 1, "logged once, not once per message"
+
+
+def test_a_node_the_master_did_not_know_stays_dead_while_the_master_cannot_be_reached(monkeypatch):
+    """`not alive(node /lidar)` for a lidar that never registered: a master that went away turned it
+    unknown, which released the stop for the whole outage (an acceptance sweep; docs/monitor.md says
+    such a node is false). No node registers without the master, so its last answer still holds."""
+    calls = []
+    answers = {("http://master:11311/", "lookupNode"): [-1, "unknown node [/driver]", ""]}
+    sampler = _fake_sampler(answers, calls, monkeypatch)
+    st = NodeStatus("driver", "/driver")
+    sampler.sample(st)
+    assert st.alive is False and st.why == "not registered with the master"
+    answers[("http://master:11311/", "lookupNode")] = ConnectionRefusedError("refused")
+    sampler.sample(st)
+    assert st.alive is False and "not registered with the master at its last answer" in st.why
+    answers[("http://master:11311/", "lookupNode")] = [1, "", "http://pc:4000/"]  # back; the node registered
+    answers[("http://pc:4000/", "getPid")] = [1, "", 77]
+    sampler.sample(st)
+    assert st.alive is True
+
+
+def test_a_node_never_asked_about_is_unknown_while_the_master_cannot_be_reached(monkeypatch):
+    answers = {("http://master:11311/", "lookupNode"): ConnectionRefusedError("refused")}
+    sampler = _fake_sampler(answers, [], monkeypatch)
+    st = NodeStatus("driver", "/driver")
+    sampler.sample(st)
+    assert st.alive is UNKNOWN and "never seen" in st.why
