@@ -58,7 +58,8 @@ class _Replayed:
         if not self.book.update(report, stamp, caller):
             return set()  # in another agent's name: ignored, as live
         for node, n in report.nodes.items():
-            if self.names.get(node) is not None and self.names[node] not in self.skip:  # only the spec's nodes
+            # only the spec's nodes, and those the monitor's samples do not cover (skip: resolved names)
+            if self.names.get(node) is not None and node not in self.skip and self.names[node] not in self.skip:
                 self.hosts[node] = n.host or report.host
         if not report.leaving:
             heapq.heappush(self.wakeups, stale_at(stamp, report.period))
@@ -80,9 +81,10 @@ def agent_samples(stream: Iterable[Record], agent_topics: Set[str], names: Dict[
                   keep: Set[str] = frozenset()) -> Iterator[Record]:  # type: ignore[assignment]
     """`stream` with each agent report replaced by node samples on SAMPLES.
 
-    names: resolved node name -> the spec's name; skip: spec names left to the monitor's own
-    samples; end: the recording's end (bag time), past which no expiry is emitted; warn: what the
-    monitor would log (a report ignored); keep: agent topics the spec reads, passed on as well.
+    names: resolved node name -> the spec's name; skip: nodes left to the monitor's own samples,
+    resolved (as `command._sampled_nodes` gives them; a spec name there counts too); end: the
+    recording's end (bag time), past which no expiry is emitted; warn: what the monitor would log
+    (a report ignored); keep: agent topics the spec reads, passed on as well.
     """
     state = _Replayed(names, skip, warn)
     done = -1.0

@@ -51,6 +51,8 @@ def test_agent_reports_drive_cpu_and_a_silent_agent_makes_it_unknown(tmp_path):
     items.append((3.0, "/other", String(data="end")))  # the recording goes on after the agent fell silent
     lines, stderr = run(tmp_path, items)
     assert "no node samples" not in stderr
+    # the agents' reports alone: said, as the replay can differ from the monitor (docs/multihost.md)
+    assert "has the agents' reports (/rubass/agent_samples) but not the monitor's ~node_samples" in stderr
     rule = [(x["time"], x["value"]) for x in lines if x["event"] == "rule"]
     assert [v for _, v in rule] == [None, False, True, None]
     assert rule[2][0] == pytest.approx(0.5, abs=1e-6)

@@ -60,7 +60,7 @@ def reference(spec, messages, start, end, rate=50.0, node_topics=()):
                 at = max(min(t, sample[4] - start), engine.store.now) if sample[4] is not None else t
                 events.extend(engine.on_node_sample(sample[0], at, *sample[1:4]))
             continue
-        if batch and t != state["batch_time"]:
+        if batch and (t != state["batch_time"] or any(name == topic for name, _ in batch)):
             flush()
         if not batch:
             ticks_until(t, inclusive=False)
