@@ -336,6 +336,7 @@ def test_a_storm_of_sighups_costs_at_most_two_reloads_and_the_newest_spec_wins(r
     body = ("entity base {{ rules: fast: topic /cmd_vel.linear.x > {} m/s; }}\nentity filler {{ rules:\n" + filler +
             "}}\nif (base.fast) then {{ brake; }}\n")
     mon = ros.monitor(spec(tmp_path, body.format(1.0)))
+    wait_log(mon, ros, "rubass: enforcing", timeout=30.0)  # its 1,000 rules are checked after ~reset is up
     for limit in range(2, 22):  # rewritten in place (truncated first), as a script would
         spec(tmp_path, body.format(float(limit)))
         os.kill(mon.pid, signal.SIGHUP)

@@ -23,5 +23,5 @@ def test_events_and_diagnostics_carry_the_witness(ros, tmp_path):
     diags = [r["msg"] for r in rec if r.get("topic") == "/diagnostics"]
     values = [v for d in diags for s in d["status"] if s["name"] == "rubass: monitor" for v in s["values"]
               if v["key"] == "last start"]
-    assert values and values[-1]["value"].startswith("fast at ")
+    assert values and values[-1]["value"].startswith('fast @id("SF-1") at ')
     assert "true: a.r; /x.data = 5" in values[-1]["value"]
