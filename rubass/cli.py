@@ -13,7 +13,7 @@ from .testing.command import register as register_test
 from .report.command import register as register_report
 from rubass_experiments.command import register as register_experiments
 from .ros.model_command import add_source_options, build_model
-from .ros.libtypes import after_check, after_failed_check
+from .ros.libtypes import after_check, failed_check
 from .ros.model_command import register as register_model
 from .lang.errors import Diagnostic, counted, in_text_order
 from .lang.source import SourceSet
@@ -36,12 +36,11 @@ def cmd_check(args: argparse.Namespace) -> int:
         try:
             checked = load_spec(path, args.actions, model=model)
         except SpecError as exc:
-            lib_errors, warnings, lib_sources = after_failed_check(path, args.actions, model)
-            for d in in_text_order(exc.in_order() + warnings + lib_errors):  # the model's warnings in their place
-                known = exc.sources is not None and exc.sources.get(d.span.file) is not None
-                print(d.render(exc.sources if known else lib_sources), file=sys.stderr)
+            found = failed_check(exc, path, args.actions, model)
+            for d, sources in found:
+                print(d.render(sources), file=sys.stderr)
             # the summary counts every error printed above it: the spec's, and its libraries'
-            n = sum(d.severity == "error" for d in exc.diagnostics + warnings + lib_errors)
+            n = sum(d.severity == "error" for d, _ in found)
             print(f"{path}: {counted(n, 'error')}", file=sys.stderr)
             status = 1
             continue

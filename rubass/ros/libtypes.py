@@ -8,7 +8,7 @@ import os
 from typing import Dict, Iterable, List, Optional, Sequence, Tuple
 
 from ..lang import ast
-from ..lang.errors import Diagnostic, SpecError
+from ..lang.errors import Diagnostic, SpecError, in_text_order
 from ..lang.grammar import parse_source
 from ..lang.library import ActionDef, load_library
 from ..lang.paths import PathError, resolve
@@ -110,6 +110,25 @@ def library_errors(actions: Dict[str, ActionDef], sources: SourceSet, model: Opt
     if model is not None:
         errors += check_publish_topics(actions, sources, model.topics, model.source)
     return errors
+
+
+def failed_check(exc: SpecError, path: str, extra: Sequence[str], model: Optional[SystemModel] = None
+                 ) -> List[Tuple[Diagnostic, Optional[SourceSet]]]:
+    """Everything wrong with a spec that did not check, in the order of the text, each with the sources
+    to render it against: its errors and warnings, and its libraries' errors against the installed
+    definitions (after_failed_check), so that `rubass check`, the monitor's start and a reload all
+    report every error in one run."""
+    lib_errors, warnings, lib_sources = after_failed_check(path, extra, model)
+    out: List[Tuple[Diagnostic, Optional[SourceSet]]] = []
+    for d in in_text_order(exc.in_order() + warnings + lib_errors):  # a model's warnings in their place
+        known = exc.sources is not None and exc.sources.get(d.span.file) is not None
+        out.append((d, exc.sources if known else lib_sources))
+    return out
+
+
+def render_failed_check(exc: SpecError, path: str, extra: Sequence[str]) -> str:
+    """failed_check as the text the monitor logs (as `rubass check` prints it)."""
+    return "\n".join(d.render(sources) for d, sources in failed_check(exc, path, extra))
 
 
 def after_failed_check(path: str, extra: Sequence[str],

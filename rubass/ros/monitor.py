@@ -53,7 +53,7 @@ from ..engine import Engine, Event
 from ..engine.loop import EngineLoop, Message, NodeSample
 from ..engine.unknowns import rule_reasons, snapshot as store_snapshot
 from ..lang import SpecError, load_spec
-from ..lang.errors import counted
+from ..lang.errors import counted, in_text_order
 from ..lang.library import priority_conflicts
 from ..lang.model import CheckedSpec
 from ..actions import status as status_mod
@@ -63,7 +63,7 @@ from .agentbook import decode as decode_agent_report
 from ..actions.runner import ActionRunner
 from ..actions.dispatch import Dispatcher
 from .master_watch import MasterWatch
-from .libtypes import after_check
+from .libtypes import after_check, render_failed_check
 from .livecheck import LiveTypeCheck
 from .nodes import NodeSampler
 from .outputs import Outputs
@@ -111,11 +111,10 @@ class Monitor(Reloading):
         """Check the spec and build its actions; StartupError with every problem found."""
         try:
             spec = load_spec(self.config.spec, self.config.actions)
-        except SpecError as exc:
-            raise StartupError(exc.render()) from None
+        except SpecError as exc:  # with its libraries' errors, as `rubass check` prints them: all in one run
+            raise StartupError(render_failed_check(exc, self.config.spec, self.config.actions)) from None
         self._check_overload_actions(spec)
-        self._check_priorities(spec)
-        self._check_library_types(spec)
+        self._check_actions(spec)
         for w in spec_warnings(spec.warnings, self.config):
             rospy.logwarn("rubass: %s", w.render(spec.sources))
         return spec, self._runners(spec, {})
@@ -131,18 +130,12 @@ class Monitor(Reloading):
                               f"declare (add 'action primitive {', '.join(missing)};')")
 
     @staticmethod
-    def _check_priorities(spec: CheckedSpec) -> None:
-        """Two actions of one priority on one topic (§16), across libraries, names resolved."""
-        conflicts = priority_conflicts(spec.actions.values(), rospy.resolve_name)
-        if conflicts:
-            raise StartupError("\n".join(d.render(spec.sources) for d in conflicts))
-
-    @staticmethod
-    def _check_library_types(spec: CheckedSpec) -> None:
-        """Publish and service actions against the installed definitions, errors at their YAML line."""
-        errors, _ = after_check(spec, None)
+    def _check_actions(spec: CheckedSpec) -> None:
+        """Two actions of one priority on one topic (§16, across libraries, names resolved), and publish
+        and service actions against the installed definitions: every error at its YAML line, at once."""
+        errors = priority_conflicts(spec.actions.values(), rospy.resolve_name) + after_check(spec, None)[0]
         if errors:
-            raise StartupError("\n".join(d.render(spec.sources) for d in errors))
+            raise StartupError("\n".join(d.render(spec.sources) for d in in_text_order(errors)))
 
     def _runners(self, spec: CheckedSpec, keep: Dict[str, ActionRunner]) -> Dict[str, ActionRunner]:
         """Runners for the spec's actions, reusing those whose definition did not change."""

@@ -18,6 +18,7 @@ from ..lang.errors import RubassError, counted
 from ..lang.libtopics import running_type_changes
 from ..lang.model import CheckedSpec
 from .gcfreeze import freeze_heap
+from .libtypes import render_failed_check
 from .topics import ros_now
 
 
@@ -78,8 +79,7 @@ class Reloading:
             try:
                 spec = self._load_stable()
                 self._check_overload_actions(spec)
-                self._check_priorities(spec)
-                self._check_library_types(spec)
+                self._check_actions(spec)
                 self._check_running_types(spec)
                 t_check = time.monotonic()
                 if self.spec is not None and self.loop is None:
@@ -118,7 +118,8 @@ class Reloading:
                 finally:
                     slow.cancel()
             except (SpecError, StartupError) as exc:
-                text = exc.render() if isinstance(exc, SpecError) else str(exc)
+                text = render_failed_check(exc, self.config.spec, self.config.actions) if isinstance(exc, SpecError) \
+                    else str(exc)
                 self.rejected += 1
                 self.last_reload_error = text.splitlines()[0] if text else "error"
                 if self.spec is None:
