@@ -70,3 +70,24 @@ def test_a_sighup_right_after_start_does_not_end_the_process(tmp_path, script):
         if proc.poll() is None:
             proc.kill()
             proc.wait()
+
+
+@pytest.mark.parametrize("script", ["monitor", "agent"])
+def test_ctrl_c_during_the_imports_exits_130_without_a_traceback(tmp_path, script):
+    """An acceptance sweep: Ctrl-C in the first ~1.2 s of `rosrun rubass monitor` printed a
+    KeyboardInterrupt traceback from whichever module was loading, exit -2."""
+    proc = subprocess.Popen([sys.executable, os.path.join(ROOT, "scripts", script)], env=_env(tmp_path),
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, start_new_session=True)
+    try:
+        end = time.monotonic() + 10.0
+        while not _ignores_sighup(proc.pid) and proc.poll() is None and time.monotonic() < end:
+            time.sleep(0.001)  # past the script's first lines, into the imports
+        time.sleep(0.05)
+        proc.send_signal(signal.SIGINT)
+        out, err = proc.communicate(timeout=15)
+        assert "Traceback" not in err and "KeyboardInterrupt" not in err, err
+        assert proc.returncode in (130, 0), (proc.returncode, err)  # 0: it had reached the wait for the master
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.wait()
