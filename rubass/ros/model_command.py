@@ -8,6 +8,7 @@ import os
 import sys
 from typing import Optional, Tuple
 
+from ..lang.errors import counted
 from ..lang.modelfile import dump_model, parse_model
 from ..lang.source import SourceSet
 from ..lang.sourcefile import read_source
@@ -105,9 +106,9 @@ def cmd_model(args: argparse.Namespace) -> int:
         except OSError as exc:
             print(f"rubass: error: cannot write {args.output}: {exc.strerror or exc}", file=sys.stderr)
             return 1
-        print(f"{args.output}: {len(model.topics)} topics, "
-              f"{'no node list' if model.nodes is None else f'{len(model.nodes)} nodes'}, "
-              f"{len(model.registry.closure(model.topics.values()))} message types", file=sys.stderr)
+        print(f"{args.output}: {counted(len(model.topics), 'topic')}, "
+              f"{'no node list' if model.nodes is None else counted(len(model.nodes), 'node')}, "
+              f"{counted(len(model.registry.closure(model.topics.values())), 'message type')}", file=sys.stderr)
     missing = model.undefined_types()
     if missing:
         print(f"rubass: warning: no definition found for {', '.join(missing)}: their fields cannot be checked",

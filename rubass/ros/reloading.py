@@ -161,8 +161,9 @@ class Reloading:
             self.last_reload_error = ""
             freeze_heap()  # the new spec and engine leave the collector's scans, as at start (gcfreeze.py)
             ms = (time.monotonic() - t0) * 1000.0
-            rospy.loginfo("rubass: reloaded %s (%s) in %.0f ms: %d rules, %d behaviours (check %.0f ms, build %.0f ms, "
-                          "swap %.1f ms)", spec.path, reason, ms, len(spec.rules), len(spec.behaviours),
+            rospy.loginfo("rubass: reloaded %s (%s) in %.0f ms: %s, %s (check %.0f ms, build %.0f ms, "
+                          "swap %.1f ms)", spec.path, reason, ms, counted(len(spec.rules), "rule"),
+                          counted(len(spec.behaviours), "behaviour"),
                           (t_check - t0) * 1000, (t_build - t_check) * 1000, (t_swap - t_build) * 1000)
             return True, (f"reloaded in {ms:.0f} ms: {counted(len(spec.rules), 'rule')}, "
                           f"{counted(len(spec.behaviours), 'behaviour')}")

@@ -222,3 +222,20 @@ def test_two_readable_types_from_two_threads_are_each_read_with_their_own_class(
     seen = {(type(g[2]).__name__, getattr(g[2], "data", None)) for g in got}
     assert seen <= {("Float64", 2.0), ("Float32", 3.0)}, seen
     assert ("Float64", 2.0) in seen and ("Float32", 3.0) in seen
+
+
+def test_a_change_to_a_type_the_spec_reads_is_a_warning_one_it_cannot_read_an_error(fake_subscriber, monkeypatch):
+    """docs/monitor.md: a topic that merely changes type, when its new type has every field the spec
+    reads, is logged but is no error (an acceptance sweep found it logged at ERROR)."""
+    from std_msgs.msg import Float32, Float64, String
+
+    watcher, state, got, logs = _watch()
+    clock = [time.time()]
+    monkeypatch.setattr(topics_mod.time, "time", lambda: clock[0])
+    watcher._callback(_raw(Float64(2.0), "/a"), state)
+    clock[0] += 5.0
+    watcher._callback(_raw(Float32(3.0), "/a"), state)  # restarted publishing float32: `data` reads
+    assert ("warn", "topic /speed changed type from std_msgs/Float64 to std_msgs/Float32") in logs, logs
+    clock[0] += 5.0
+    watcher._callback(_raw(String("x"), "/a"), state)  # `data` a string now: the rule cannot read it
+    assert ("error", "topic /speed changed type from std_msgs/Float32 to std_msgs/String") in logs, logs
