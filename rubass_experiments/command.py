@@ -72,6 +72,11 @@ def _run(rows: List[Row], reps: int, out: str, sup: Supervisor) -> int:
     png = os.path.join(out, "table.png")
     if outcome.signal is None:
         plot(data, png)
+    elif os.path.exists(png):  # an earlier run's plot beside this table would disagree with it
+        try:
+            os.remove(png)
+        except OSError as exc:
+            _say(sys.stderr, f"rubass experiments: cannot remove the earlier plot {png}: {exc.strerror or exc}\n")
     bags = f"{os.path.join(out, 'runs')}/ROW/N/run.bag (rubass replay SPEC BAG)"
     _say(sys.stdout, f"\ntable: {os.path.join(out, 'table.json')}\nplot:  "
                      f"{png if outcome.signal is None else '(not drawn: interrupted)'}\nbags:  {bags}\n")
