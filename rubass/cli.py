@@ -6,7 +6,7 @@ import os
 import sys
 from typing import List, Optional, Sequence
 
-from .lang import SpecError, format_spec, load_spec, parse_source
+from .lang import SpecError, format_spec, parse_source
 from .lang.topicnames import spellings
 from .replay.command import register as register_replay
 from .testing.command import register as register_test
@@ -14,6 +14,7 @@ from .report.command import register as register_report
 from rubass_experiments.command import register as register_experiments
 from .ros.model_command import add_source_options, build_model
 from .ros.libtypes import after_check, failed_check
+from .ros.model_sources import load_spec_against
 from .ros.model_command import register as register_model
 from .lang.errors import Diagnostic, counted, in_text_order
 from .lang.source import SourceSet
@@ -34,7 +35,7 @@ def cmd_check(args: argparse.Namespace) -> int:
         return status
     for path in args.spec:
         try:
-            checked = load_spec(path, args.actions, model=model)
+            checked = load_spec_against(path, args.actions, model, getattr(args, "bag", None))  # every recorded type
         except SpecError as exc:
             found = failed_check(exc, path, args.actions, model)
             for d, sources in found:

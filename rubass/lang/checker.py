@@ -265,11 +265,31 @@ class _Checker:
                 declared[ident.name] = ident.span
                 if ident.name not in library and not self._broken_in_library(ident.name) \
                         and not self._unusable_libraries:
+                    failed = self._failed_imports(loaded)
                     where = ("no action library is loaded: add 'import \"actions.yaml\";' or pass --actions"
                              if not loaded else "loaded: " + ", ".join(loaded))
+                    if failed:  # the spec has an import: say that it failed, not that there is none
+                        where = (f"{'its library' if len(failed) == 1 else 'its libraries'} "
+                                 f"{', '.join(repr(f) for f in failed)} could not be loaded: see the error above"
+                                 + (f"; loaded: {', '.join(loaded)}" if loaded else ""))
                     self.error(ident.span, f"action '{ident.name}' is not defined in any action library "
                                            f"({where}){did_you_mean(ident.name, library)}")
         return declared
+
+    def _failed_imports(self, loaded: List[str]) -> List[str]:
+        """The spec's imports (as written) that could not be loaded: a package not found, no such file."""
+        base = os.path.dirname(os.path.abspath(self.spec.file))
+        out: List[str] = []
+        for d in self.spec.decls:
+            if not isinstance(d, ast.Import):
+                continue
+            try:
+                path: Optional[str] = resolve(d.path, base)
+            except PathError:
+                path = None
+            if path not in loaded and path not in self._unusable_libraries and d.path not in out:
+                out.append(d.path)
+        return out
 
     def _own_span(self, d: ast.Behaviour) -> Span:
         """A behaviour's span from its name or its `if`, after its attributes: its line is the one

@@ -3,7 +3,7 @@ service type exists, and every field of `message:`, `on_release:` and `request:`
 value of a fitting type. Errors point at the YAML file and line."""
 from __future__ import annotations
 
-from typing import Any, Dict, Iterable, List, Optional, Tuple
+from typing import Any, Callable, Dict, Iterable, List, Optional, Tuple
 
 import yaml
 
@@ -261,3 +261,24 @@ def argument_problem(action: ActionDef, nargs: int, span: Span) -> Optional[Diag
                             f"(it does what its library entry says, {action.span}); only log actions (the text of "
                             f"their line) and custom plugins (ctx.args) use arguments: write '{action.name};', or "
                             f"change the library")
+
+
+def plugin_module_warnings(actions: Dict[str, ActionDef], found: Callable[[str], bool]) -> List[Diagnostic]:
+    """A warning at the `plugin:` value of each custom plugin whose top-level package `found` does not find
+    (it looks the name up, it runs none of it): the monitor imports the module when it starts and refuses
+    to start if it cannot. Only a warning: the robot's package may be on the robot's Python path only."""
+    diags: List[Diagnostic] = []
+    for act in sorted(actions.values(), key=lambda a: (a.span.file, a.span.line)):
+        if not act.is_custom:
+            continue
+        module = act.plugin.partition(":")[0]
+        top = module.split(".")[0]
+        if found(top):
+            continue
+        span = act.plugin_span if act.plugin_span.line > 0 else act.span
+        diags.append(Diagnostic(span, f"action '{act.name}': plugin module '{module}' cannot be found here "
+                                      f"(no package or module '{top}' on this Python's path): the monitor will "
+                                      f"refuse to start unless it can import it there (on the robot, with its "
+                                      f"package on the Python path: its workspace's setup.bash sourced)",
+                                "warning", subject=act.name))
+    return diags

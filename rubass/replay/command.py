@@ -263,6 +263,11 @@ DAY = 86400.0
 
 
 def _warn_unsampled(nodes: Iterable[str], bag: Any, node_topics: List[str], agent_topics: List[str]) -> None:
+    for text in unsampled_warnings(nodes, bag, node_topics, agent_topics):
+        print(f"rubass replay: warning: {text}", file=sys.stderr)
+
+
+def unsampled_warnings(nodes: Iterable[str], bag: Any, node_topics: List[str], agent_topics: List[str]) -> List[str]:
     """A warning for each node of the spec that no recorded node sample (a monitor's or an agent's) covers:
     its alive(), cpu() and memory() stay unknown in the replay. BagError if the bag cannot be read."""
     from ..ros.agentbook import decode as decode_report
@@ -275,10 +280,8 @@ def _warn_unsampled(nodes: Iterable[str], bag: Any, node_topics: List[str], agen
             covered.update(resolve_node(n) for n in decode_report(msg.data).nodes)
         except (ValueError, AttributeError):
             continue
-    for node in sorted(nodes):
-        if resolve_node(node) not in covered:
-            print(f"rubass replay: warning: the recording has node samples, but none of node {node} "
-                  f"({resolve_node(node)}); its alive(), cpu() and memory() stay unknown", file=sys.stderr)
+    return [f"the recording has node samples, but none of node {node} ({resolve_node(node)}); its alive(), "
+            f"cpu() and memory() stay unknown" for node in sorted(nodes) if resolve_node(node) not in covered]
 
 
 def _warn_span(spec: Any, bag: Any, info: Any, rate: float) -> None:

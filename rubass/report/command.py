@@ -6,6 +6,8 @@ import os
 import sys
 
 from ..lang import SpecError, load_spec
+from ..lang.errors import in_text_order
+from ..replay.command import is_bag
 
 
 def register(sub: "argparse._SubParsersAction[argparse.ArgumentParser]") -> None:
@@ -32,11 +34,18 @@ def run(args: argparse.Namespace) -> int:
     from .hazards import HazardsError, read_hazards
     from .html import render
 
+    if is_bag(args.spec):
+        print(f"rubass report: error: {args.spec} is a ROS bag, not a spec (usage: rubass report SPEC --bag BAG "
+              f"[--tests FILE.test.yaml ...] -o report.html)", file=sys.stderr)
+        return 1
     try:
         spec = load_spec(args.spec, args.actions)
     except SpecError as exc:
         print(exc.render(), file=sys.stderr)
         return 1
+    said = [d.render(spec.sources) for d in in_text_order(spec.warnings)]  # as `rubass check` prints them
+    if said:
+        print("\n".join(said), file=sys.stderr)
     try:
         hazards = read_hazards(args.hazards) if args.hazards else []
     except HazardsError as exc:  # every error of the risk table, each at its place
@@ -61,6 +70,10 @@ def run(args: argparse.Namespace) -> int:
                   f"{'are' if len(r.outcomes) != 1 else 'is'} not counted (give the test files of {args.spec}, whose 'spec:' names it)", file=sys.stderr)
     bags = [replay_bag(spec, path, actions=args.actions) for path in args.bag]
     for b in bags:
+        more = [w for w in b.spec_warnings if w not in said]  # the spec's, against this recording's types
+        said += more
+        for line in more + [f"rubass report: warning: {b.path}: {w}" for w in b.warnings]:
+            print(line, file=sys.stderr)
         if b.type_errors:  # at the spec's line, as `rubass check --bag` prints them
             print("\n".join(b.type_errors), file=sys.stderr)
             print(f"rubass report: error: {b.path} not replayed: {args.spec} cannot read its types (above); the "

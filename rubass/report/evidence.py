@@ -1,7 +1,6 @@
 """What a report shows, gathered: the spec's traceability, test results, bag replays, measured reaction."""
 from __future__ import annotations
 
-
 import os
 from dataclasses import dataclass, field
 from typing import Any, Dict, List, Optional, Sequence, Set, Tuple
@@ -33,6 +32,7 @@ class BagRun:
     error: str = ""
     warnings: List[str] = field(default_factory=list)
     type_errors: List[str] = field(default_factory=list)  # the spec against the recording's types, printed as is
+    spec_warnings: List[str] = field(default_factory=list)  # the spec's, read against the recording, rendered
 
 
 @dataclass
@@ -192,7 +192,7 @@ def _failing(tests: List[Outcome]) -> List[str]:
 def replay_bag(spec: CheckedSpec, path: str, rate: float = 50.0, actions: Sequence[str] = ()) -> BagRun:
     """The spec over a recording, as `rubass replay` runs it; not replayed (`error`, `type_errors`) when the
     spec cannot read the recording's types, as `rubass replay` and `rubass check --bag` refuse it."""
-    from ..replay.command import bag_type_errors
+    from ..replay.command import bag_check
     from ..replay.run import replay
     from ..ros.bag import BagError, open_bag, read
 
@@ -213,11 +213,17 @@ def replay_bag(spec: CheckedSpec, path: str, rate: float = 50.0, actions: Sequen
         agent_topics = sorted(t for t in strings if t.endswith("/agent_samples"))
         decode = {t for t in present if any(spec.topics[n].needs_data for n in names[t])} | set(node_topics) | \
             set(agent_topics)
-        run.type_errors = bag_type_errors(spec, spec.path, actions, bag, path, info, decode, "rubass report")
+        run.type_errors, run.spec_warnings = bag_check(spec, spec.path, actions, bag, path, info, decode,
+                                                       "rubass report")
         if run.type_errors:
             run.warnings = []
             run.error = (f"not replayed: {os.path.basename(spec.path)} cannot read this recording's types "
                          f"(as `rubass check --bag` and `rubass replay` say):")
+            return run
+        try:
+            run.warnings += unsampled_nodes(spec, bag, node_topics, agent_topics)
+        except BagError as exc:
+            run.error = str(exc)
             return run
         stream: Any = ((t, name, msg) for t, topic, msg in read(bag, present + node_topics + agent_topics, decode)
                        for name in names.get(topic, (topic,)))
@@ -236,6 +242,16 @@ def replay_bag(spec: CheckedSpec, path: str, rate: float = 50.0, actions: Sequen
             return run
     run.duration, run.messages = info.end - info.start, info.messages
     return run
+
+
+def unsampled_nodes(spec: CheckedSpec, bag: Any, node_topics: List[str], agent_topics: List[str]) -> List[str]:
+    """`rubass replay`'s warning for each node of the spec that no recorded node sample covers (when the
+    recording has some), as text; BagError if the bag cannot be read."""
+    from ..replay.command import unsampled_warnings
+
+    if not spec.nodes or not (node_topics or agent_topics):
+        return []
+    return unsampled_warnings(spec.nodes, bag, node_topics, agent_topics)
 
 
 def spec_text(spec: CheckedSpec, span: Any) -> str:

@@ -4,6 +4,7 @@ Light: the monitor runs these at start and at every reload."""
 from __future__ import annotations
 
 import importlib
+import importlib.util
 import os
 from typing import Dict, Iterable, List, Optional, Sequence, Tuple
 
@@ -14,7 +15,7 @@ from ..lang.library import ActionDef, load_library
 from ..lang.paths import PathError, resolve
 from ..lang.source import SourceSet
 from ..lang.sourcefile import read_source
-from ..lang.libcheck import check_library_types, check_publish_topics, library_types
+from ..lang.libcheck import check_library_types, check_publish_topics, library_types, plugin_module_warnings
 from ..lang.model import CheckedSpec
 from ..lang.msgdef import Registry, parse_full
 from ..lang.stdlib import is_standard_library
@@ -25,6 +26,17 @@ def _importable(type_name: str) -> bool:
     """Whether looking the type up may import its package: never a standard library module
     (importing 'antigravity' opens a browser, and a library is not to run code)."""
     return not is_standard_library(type_name.split("/")[0])
+
+
+def top_level_found(name: str) -> bool:
+    """Whether this Python finds a top-level package or module: looked up on the path, not imported (for a
+    top-level name importlib.util.find_spec runs none of its code, so a library still runs nothing)."""
+    if not name.isidentifier():
+        return False
+    try:
+        return importlib.util.find_spec(name) is not None
+    except (ImportError, ValueError):  # a module in sys.modules without a spec, a broken finder
+        return False
 
 
 def add_installed(registry: Registry, msg_types: Iterable[str], srv_types: Iterable[str] = ()) -> None:
@@ -88,8 +100,10 @@ def try_installed(registry: Registry, msgs: Iterable[str], srvs: Iterable[str]) 
 
 def after_check(checked: CheckedSpec, model: Optional[SystemModel]) -> Tuple[List[Diagnostic], List[Diagnostic]]:
     """(errors, warnings) of the checks against the system: the spec's topics and nodes the
-    model lacks (warnings), and its action libraries against message definitions (errors)."""
+    model lacks (warnings), custom plugins whose package this Python cannot find (warnings), and
+    its action libraries against message definitions (errors)."""
     warnings = graph_warnings(checked.spec, model) if model is not None else []
+    warnings += plugin_module_warnings(checked.actions, top_level_found)  # the monitor would refuse to start
     return library_errors(checked.actions, checked.sources, model), warnings
 
 
@@ -154,4 +168,5 @@ def after_failed_check(path: str, extra: Sequence[str],
             continue
         lib, _ = load_library(f, sources)  # its own errors are reported already; check its valid actions
         actions.update(lib)
+    warnings += plugin_module_warnings(actions, top_level_found)
     return library_errors(actions, sources, model), warnings, sources

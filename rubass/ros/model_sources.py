@@ -3,15 +3,19 @@ master, definitions of types not installed from the publishers' TCPROS handshake
 from /robot_description), and installed message and service definitions."""
 from __future__ import annotations
 
+import dataclasses
 import io
 import os
 import socket
-from typing import Dict, Optional
+from typing import Dict, List, Optional, Sequence
 
-from ..lang.errors import RubassError
+from ..lang import SpecError, load_spec
+from ..lang.errors import Diagnostic, RubassError
+from ..lang.model import CheckedSpec
 from ..lang.msgdef import DefinitionError, Registry
 from ..lang.std_units import joint_state_units, urdf_joint_kinds
-from ..lang.sysmodel import SystemModel
+from ..lang.sysmodel import SystemModel, norm_topic
+from ..lang.topicnames import spellings
 from .bag import BagError, open_bag
 from .libtypes import add_installed
 from .rpc import proxy as rpc_proxy
@@ -38,6 +42,65 @@ def bag_model(path: str) -> SystemModel:
     # No node list: a bag names only publishers, and often as the recorder or player
     # ('/play_1633455785917753240') rather than the node that ran on the robot.
     return SystemModel(dict(info.types), None, registry, source=f"the recording {os.path.basename(path)}")
+
+
+def recorded_types(path: str) -> Dict[str, List[str]]:
+    """Topic -> every type recorded on it, the one bag_model gives it first (a topic may have connections
+    of several types); BagError if the recording cannot be read."""
+    bag, info = open_bag(path)
+    try:
+        out = {t: [ty] for t, ty in info.types.items()}
+        for conn in bag._connections.values():  # both readers keep the connections here
+            kinds = out.setdefault(conn.topic, [conn.datatype])
+            if conn.datatype not in kinds:
+                kinds.append(conn.datatype)
+    finally:
+        bag.close()
+    return out
+
+
+def load_spec_against(path: str, actions: Sequence[str], model: Optional[SystemModel],
+                      bag: Optional[str] = None) -> CheckedSpec:
+    """load_spec(path, actions, model=model); with `bag`, the recording `model` is of, the spec is read
+    against every other type recorded on one of its topics as well (as `rubass replay` reads it, and
+    refuses it if it cannot): each error of that reading at its place, naming the type. SpecError with
+    every error, the spec's against the topics' first types and these."""
+    checked: Optional[CheckedSpec] = None
+    failed: Optional[SpecError] = None
+    try:
+        checked = load_spec(path, list(actions), model=model)
+    except SpecError as exc:
+        if bag is None or model is None:
+            raise
+        failed = exc
+    if bag is None or model is None:
+        assert checked is not None
+        return checked
+    try:
+        kinds_of = recorded_types(bag)
+    except BagError:  # read for the model a moment ago: nothing more to say than bag_model said
+        kinds_of = {}
+    wanted = None if checked is None else {norm_topic(t) for t in spellings(checked.topics)}
+    errors = list(failed.diagnostics) if failed is not None else []
+    new: List[Diagnostic] = []
+    for topic, kinds in sorted(kinds_of.items()):
+        if wanted is not None and norm_topic(topic) not in wanted:
+            continue  # a topic the spec does not read
+        for type_name in kinds[1:]:
+            variant = dataclasses.replace(model, topics={**model.topics, norm_topic(topic): type_name})
+            try:
+                load_spec(path, list(actions), model=variant)
+            except SpecError as exc:
+                note = (f"{topic} is recorded as {type_name} too in {os.path.basename(bag)} (first as {kinds[0]}): "
+                        f"this is the spec read against {type_name}")
+                new += [dataclasses.replace(d, message=f"{d.message}; {note}") for d in exc.diagnostics
+                        if d not in errors]
+    if failed is not None:
+        raise SpecError(errors + new, failed.sources, failed.warnings) if new else failed
+    assert checked is not None
+    if new:
+        raise SpecError(new, checked.sources, checked.warnings)
+    return checked
 
 
 def _master(uri: Optional[str], timeout: float):  # type: ignore[no-untyped-def]
