@@ -96,7 +96,8 @@ def _parser() -> argparse.ArgumentParser:
     c.add_argument("spec", nargs="+", metavar="SPEC")
     c.add_argument("--actions", action="append", default=[], metavar="LIB.yaml",
                    help="an action library to load besides the spec's imports (repeatable)")
-    c.add_argument("-q", "--quiet", action="store_true", help="print nothing when clean")
+    c.add_argument("-q", "--quiet", action="store_true",
+                   help="leave out the 'ok' line of each clean spec (errors and warnings are still printed)")
     add_source_options(c, for_check=True)
     c.set_defaults(func=cmd_check)
     f = sub.add_parser("fmt", help="print a spec in canonical layout")

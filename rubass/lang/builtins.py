@@ -9,8 +9,9 @@ from dataclasses import replace
 from typing import Any, FrozenSet, List, Tuple
 
 from . import ast
+from .errors import a_noun
 from .geometry import polygon_problem
-from .units import COUNT, DIMENSIONLESS, FREQUENCY, LENGTH, MEMORY, TIME, dim_mul
+from .units import COUNT, DIMENSIONLESS, FREQUENCY, LENGTH, MEMORY, TIME, dim_mul, dimension_name
 
 # Ty, BOOL, … live in typecheck, which imports this module: _types() finds it when a check runs
 # (an import statement in each method would cost more than the method's own work).
@@ -96,7 +97,9 @@ class BuiltinChecks:
         window = 1.0
         if len(args) == 2:
             lit, wty = self.check(args[1])  # type: ignore[attr-defined]
-            if not isinstance(lit, ast.Lit) or wty.dim != TIME or wty.bare \
+            if isinstance(lit, ast.Lit) and wty.kind == "any":
+                pass  # an unknown unit, a number too large: said where it is written, not again here
+            elif not isinstance(lit, ast.Lit) or wty.dim != TIME or wty.bare \
                     or not isinstance(lit.value, float) or not lit.value > 0 or math.isinf(lit.value):
                 self.error(args[1].span, "the window of frequency() must be a positive constant time, "  # type: ignore[attr-defined]
                                          "such as '2 s'")
@@ -196,8 +199,10 @@ class BuiltinChecks:
         for sub in ast.walk(body):
             if isinstance(sub, (ast.For, ast.Within, ast.Latch)):
                 word = {ast.For: "'for'", ast.Within: "'within'", ast.Latch: "latch()"}[type(sub)]
+                instead = {ast.For: f"({e.func}(…)) for 1 s", ast.Within: f"({e.func}(…)) within 1 s",
+                           ast.Latch: f"latch({e.func}(…), …)"}[type(sub)]
                 self.error(sub.span, f"{word} cannot be used inside {e.func}(): an element has no history; "  # type: ignore[attr-defined]
-                                     f"apply it to the quantifier instead, e.g. ({e.func}(…)) for 1 s")
+                                     f"apply it to the quantifier instead, e.g. {instead}")
                 return e, ANY
         nested = any(isinstance(x, ast.Call) and x.func in ("any", "all", "count") for x in ast.walk(body))
         if ctx.array is None and (nested or ctx.reported):
@@ -264,9 +269,8 @@ class BuiltinChecks:
                     ok = False
                     continue
                 if not ty.bare and ty.dim != LENGTH:
-                    from .units import dimension_name
-                    self.error(c.span, f"a vertex's coordinate must be a length, not a "  # type: ignore[attr-defined]
-                                       f"{dimension_name(ty.dim) if ty.dim is not None else 'number'}")
+                    self.error(c.span, f"a vertex's coordinate must be a length, not "  # type: ignore[attr-defined]
+                                       f"{a_noun(dimension_name(ty.dim)) if ty.dim is not None else 'a number'}")
                     ok = False
                 dims.add("bare" if ty.bare else "length")
                 coords.append(lit.value)

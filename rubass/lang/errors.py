@@ -78,10 +78,12 @@ def counted(n: int, noun: str) -> str:
 
 
 def a_noun(noun: str) -> str:
-    """The noun with its indefinite article: 'a time', 'an entity', 'a quantity in m*s'."""
-    if not noun.replace(" ", "").isalpha():  # a formula of units, such as m*s or m^3
+    """The noun with its indefinite article: 'a time', 'an entity', 'an angle', 'a quantity in m*s'."""
+    if any(c in noun for c in "*^") or not noun[:1].isalpha():  # a formula of units, such as m*s or m^3
         return f"a quantity in {noun}"
-    return ("an " if noun[:1] in "aeiou" else "a ") + noun
+    low = noun.lower()
+    vowel = low[:1] in "aeiou" and not low.startswith(("uni", "use", "usu", "one", "eu"))  # 'a unit'
+    return ("an " if vowel else "a ") + noun
 
 
 def did_you_mean(name: str, candidates: Iterable[str]) -> str:

@@ -23,6 +23,14 @@ def format_number(value: float) -> str:
     return repr(value)
 
 
+def _num_text(e: ast.Num) -> str:
+    """A number literal: as format_number writes its value, but one too small for a float (1e-999,
+    read as 0 and an error of the checker's) as written, so that the formatter does not make it 0."""
+    if e.value == 0.0 and e.text and any(c in "123456789" for c in e.text.lower().split("e")[0]):
+        return ("-" if math.copysign(1.0, e.value) < 0 else "") + e.text
+    return format_number(e.value)
+
+
 def _quote(s: str) -> str:
     return '"' + s.replace("\\", "\\\\").replace('"', '\\"') + '"'
 
@@ -55,7 +63,7 @@ def _args(*parts: str) -> str:
 def _expr(e: ast.Expr, arr: Optional[ast.TopicRef] = None) -> str:
     f = lambda x, need=0: format_expr(x, need, arr)  # noqa: E731
     if isinstance(e, ast.Num):
-        return format_number(e.value) + (f" {e.unit}" if e.unit else "")
+        return _num_text(e) + (f" {e.unit}" if e.unit else "")
     if isinstance(e, ast.Lit):
         v = e.value
         if isinstance(v, bool):
@@ -85,10 +93,21 @@ def _expr(e: ast.Expr, arr: Optional[ast.TopicRef] = None) -> str:
         p = _PREC[e.op]
         terms = ast.chain(e, e.op)  # iteratively: a generated chain may have hundreds of terms
         return f" {e.op} ".join([f(terms[0], p)] + [f(t, p + 1) for t in terms[1:]])
+    if isinstance(e, ast.Binary) and _PREC[e.op] == 5:
+        return f"{f(e.left, 6)} {e.op} {f(e.right, 6)}"
     if isinstance(e, ast.Binary):
+        # a + b - c …: along its left side, without recursion (of a sum of a thousand terms `check`
+        # says 'nested too deeply', but `fmt` must still print it)
         p = _PREC[e.op]
-        left_need = p + 1 if p == 5 else p
-        return f"{f(e.left, left_need)} {e.op} {f(e.right, p + 1)}"
+        spine: List[ast.Binary] = []
+        node: ast.Expr = e
+        while isinstance(node, ast.Binary) and _PREC[node.op] == p:
+            spine.append(node)
+            node = node.left
+        text = f(node, p)
+        for b in reversed(spine):
+            text = f"{text} {b.op} {f(b.right, p + 1)}"
+        return text
     if isinstance(e, (ast.For, ast.Within)):
         word = "for" if isinstance(e, ast.For) else "within"
         operand = f(e.operand) if _prec(e.operand) == 1 else f(e.operand, 8)  # `A for 1 s within 2 s`
@@ -258,11 +277,13 @@ def _decl(d: ast.Decl, com: _Comments) -> List[str]:
 def _entity(d: ast.Entity, com: _Comments) -> List[str]:
     nodes = f": {', '.join(n.name for n in d.nodes)}" if d.nodes else ""
     lines = [f"entity {d.name.name}{nodes} {{", "  rules:"]
-    for h in com.header.get(d.span.start, []):  # '&': it stood on the 'rules:' line
-        if h.startswith("&") and len(lines) == 2:
+    same_line = True  # the next comment of the header may still go on the 'rules:' line
+    for h in com.header.get(d.span.start, []):  # '&': it stood on a line of the header, after code
+        if h.startswith("&") and same_line:
             lines[-1] += "  " + h[1:]
         else:
             lines.append("    " + h.lstrip("&"))
+        same_line = h.startswith("&/*") and same_line  # nothing can follow a '//' comment on its line
     for r in d.rules:
         lines.extend("    " + c for c in com.leading.get(r.span.start, []))
         lines.extend("    " + a for a in _attrs(r.attrs))

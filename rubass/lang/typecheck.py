@@ -109,13 +109,15 @@ class ExprChecker(BuiltinChecks):
         if method is None:
             method = getattr(type(self), "_" + type(expr).__name__.lower())  # _binary for Binary
             self._methods[type(expr)] = method
+        errors = len(self.diags)
         out, ty = method(self, expr)
         if type(out) is ast.Lit:
-            if type(out.value) is float and not math.isfinite(out.value) and type(expr) is not ast.Num:
+            if type(out.value) is float and not math.isfinite(out.value):
                 self.error(expr.span, "this constant expression overflows to infinity: a limit of infinity "
                                       "would never trip (to say 'no limit', leave the rule out)")
                 out = ast.Lit(0.0, span=out.span)  # reported once, not again by what uses it
-        elif _literal_operands(out) and not any(w.span == expr.span for w in self.warnings):
+        elif _literal_operands(out) and len(self.diags) == errors \
+                and not any(w.span == expr.span for w in self.warnings):  # an error said there: not a warning too
             # _fold left it: unknown whatever the robot does, as at run time (issue 20.1), but said
             self.warn(expr.span, "this constant expression has no value (a division by zero, the square root "
                                  "of a negative number, …): it is unknown, and so is what uses it")
@@ -136,7 +138,16 @@ class ExprChecker(BuiltinChecks):
         if unit is None:
             self.error(e.span, f"unknown unit '{e.unit}'{unit_suggestion(e.unit)}")
             return ast.Lit(e.value, span=e.span), ANY
-        return ast.Lit(e.value * unit[0], span=e.span), num(unit[1])
+        value = e.value * unit[0]
+        if not math.isfinite(value):  # 1e308 km: the literal is finite, its value in SI units is not
+            self.error(e.span, f"the number '{_written(e)}' is too large once converted to SI units (the largest is "
+                               "about 1.8e308): a limit of infinity would never trip")
+            return ast.Lit(0.0, span=e.span), ANY
+        if value == 0.0 and e.value != 0.0:  # 1e-322 us: 1e-328 s is read as 0
+            self.error(e.span, f"the number '{_written(e)}' is too small: once converted to SI units it would be "
+                               "read as 0 (the smallest is about 5e-324)")
+            return ast.Lit(0.0, span=e.span), ANY
+        return ast.Lit(value, span=e.span), num(unit[1])
 
     def _bool(self, e: ast.Bool) -> Tuple[ast.Expr, Ty]:
         return ast.Lit(e.value, span=e.span), BOOL
@@ -343,9 +354,11 @@ class ExprChecker(BuiltinChecks):
         operand, ty = self.check(e.operand)
         if ty.kind not in _CONDITION:
             self._want_bool(ty, e.operand.span, f"'{word}'")
+        warned = len(self.warnings)
         duration, dty = self.check(e.duration)
         if not isinstance(duration, ast.Lit) or not isinstance(duration.value, float):
             if _constant(duration) and dty.kind == "num":
+                del self.warnings[warned:]  # 'has no value' is the error below
                 self.error(e.duration.span, f"the duration of '{word}' is not a number (a division by zero, "
                                             "or the square root of a negative)")
             else:
@@ -356,7 +369,7 @@ class ExprChecker(BuiltinChecks):
             self.error(e.duration.span, f"the duration of '{word}' needs a unit of time: write "
                                         f"'{_num_text(duration.value)} s'")
         elif dty.dim != TIME:
-            self.error(e.duration.span, f"the duration of '{word}' must be a time, not a {_describe(dty)}")
+            self.error(e.duration.span, f"the duration of '{word}' must be a time, not {_a_describe(dty)}")
         elif duration.value < 0:
             self.error(e.duration.span, f"the duration of '{word}' cannot be negative")
         elif math.isinf(duration.value):
@@ -382,6 +395,11 @@ class ExprChecker(BuiltinChecks):
         args, tys = [], []
         wrong = False
         for a in e.args:
+            if e.func in ("min", "max") and self._array_among_values(e.func, a):
+                args.append(a)
+                tys.append(ANY)
+                wrong = True  # said once: not again by what uses the call
+                continue
             out, ty = self.check(a)
             if ty.kind not in _NUMBER:
                 self._want_num(ty, a.span, f"{e.func}()")
@@ -400,6 +418,27 @@ class ExprChecker(BuiltinChecks):
         return _fold(ast.Call(e.func, tuple(args), e.span)), result
 
     # -- helpers -------------------------------------------------------------------------
+    def _array_among_values(self, func: str, a: ast.Expr) -> bool:
+        """min(topic /scan.ranges[0:90], 1 m): an array where min() of several values takes single
+        values; said (True) in words that name both forms. Inside a quantifier an array term is one
+        element, a single value."""
+        if not isinstance(a, ast.TopicRef) or not a.path or not self.scope.dynamic:
+            return False
+        if ast.slice_at(a.path) >= 0:
+            if self.quant is not None:
+                return False  # inside a quantifier an array term is one element
+            if self._path_problem(a):
+                return True  # a wrong path: said there
+        else:
+            model = self.scope.model
+            info = model.field(a.topic, a.path) if model is not None else None
+            if info is None or info.kind != "array":
+                return False
+        term = f"topic {a.topic}{a.path_text}"
+        self.error(a.span, f"{func}() takes either one array or several single values, and '{term}' is an array "
+                           f"among values: take its {func} first, e.g. {func}({func}({term}), …)")
+        return True
+
     def _want_bool(self, ty: Ty, span: Span, what: str) -> None:
         if ty.kind not in ("bool", "any"):
             self.error(span, f"{what} needs a condition (true or false), not a {_describe(ty)}")
@@ -415,20 +454,33 @@ class ExprChecker(BuiltinChecks):
 
 
 def _join(a: Ty, b: Ty) -> Ty:
-    """The type of a + b (already checked compatible)."""
-    if a.kind != "num" or b.kind != "num":  # a topic field takes the dimension of what it meets
+    """The type of a + b, min(a, b), max(a, b), the same whichever comes first: a known dimension
+    wins over an unknown one (a topic field takes the dimension of what it meets, §4), which wins
+    over a bare number's; two different known dimensions (an error, said by _same_dim) give an
+    unknown one, so that what uses the sum reports nothing more."""
+    if a.kind != "num" or b.kind != "num":  # 'any': an unknown field, or a mistake already said
         known = a if a.kind == "num" else b
         return known if known.kind == "num" and not known.bare else num(None)
-    if a.bare:
-        return b
-    if b.bare or b.dim is None:
-        return a if a.dim is not None else b
-    return a
+    if a.dim is not None and not a.bare and b.dim is not None and not b.bare:
+        return a if a.dim == b.dim else num(None)
+    for ty in (a, b):
+        if ty.dim is not None and not ty.bare:
+            return ty
+    if a.dim is None or b.dim is None:
+        return num(None)
+    return a  # both bare
 
 
 def _dim_noun(d: Dimension) -> str:
     """'a length', 'a plain number' (no dimension: a quaternion's component, cpu(), 50 %)."""
     return "a plain number" if d == DIMENSIONLESS else a_noun(dimension_name(d))
+
+
+def _a_describe(ty: Ty) -> str:
+    """'a length', 'a plain number', 'a condition': what a value is, its dimension named when known."""
+    if ty.kind == "num" and ty.dim is not None and not ty.bare:
+        return _dim_noun(ty.dim)
+    return "a " + _describe(ty)
 
 
 def _describe(ty: Ty) -> str:
@@ -437,6 +489,12 @@ def _describe(ty: Ty) -> str:
             return "number"
         return f"number ({dimension_name(ty.dim)})"
     return {"bool": "condition", "str": "string", "any": "value", "polygon": "polygon"}[ty.kind]
+
+
+def _written(e: ast.Num) -> str:
+    """A number literal as written, with its unit: '1e308 km'."""
+    sign = "-" if math.copysign(1.0, e.value) < 0 else ""
+    return sign + (e.text or _num_text(abs(e.value))) + (f" {e.unit}" if e.unit else "")
 
 
 def _num_text(v: float) -> str:

@@ -3,6 +3,8 @@ from __future__ import annotations
 
 from typing import Dict, Optional, Tuple
 
+from .errors import a_noun
+
 # A dimension is a sorted tuple of (base, exponent); bases: m, s, rad, B, and V (voltage),
 # A (current), degC (temperature), Pa (pressure), geo_deg (latitude/longitude, see GEO_DEGREE).
 Dimension = Tuple[Tuple[str, int], ...]
@@ -163,7 +165,7 @@ def unit_suggestion(unit: str) -> str:
         if exact:
             return f"; did you mean '{exact[0]}'?"
         if same:
-            return f"; a {dimension_name(meant[1])} is written in {', '.join(same)}"
+            return f"; {a_noun(dimension_name(meant[1]))} is written in {', '.join(same)}"
         return ""  # 's^2/m': the inverse 'm/s^2' is spelt alike but means something else
     alone = _SPELLINGS.get(unit, _SPELLINGS.get(unit.lower()))
     if alone is not None:

@@ -9,7 +9,7 @@ from __future__ import annotations
 import re
 from typing import Any, List
 
-from ..lang.errors import RubassError
+from ..lang.errors import RubassError, a_noun
 from ..lang.units import UNITS, dimension_name, unit_suggestion
 
 GAP: Any = object()  # a step with no message
@@ -55,15 +55,15 @@ def value(word: str, field_dim: Any = UNKNOWN, field: str = "the field") -> Any:
         raise SeriesError(f"'{word}' is not a value (a number, nan, inf, true, false or a quoted string)")
     known = field_dim is not UNKNOWN and field_dim is not None
     if unit not in UNITS:
-        hint = f" (units of a {dimension_name(field_dim)}: {_units_of(field_dim)})" if known and _units_of(field_dim) \
+        hint = f" (units of {a_noun(dimension_name(field_dim))}: {_units_of(field_dim)})" if known and _units_of(field_dim) \
             else ""
         meant = unit_suggestion(unit)
         meant = meant if meant.startswith("; did you mean") else ""
         raise SeriesError(f"'{word}': '{unit}' is not a unit rubass knows{meant}{hint}")
     factor, udim = UNITS[unit]
     if known and udim != field_dim:
-        raise SeriesError(f"'{word}' is a {dimension_name(udim)} ({unit}), but {field} is a "
-                          f"{dimension_name(field_dim)} (units: {_units_of(field_dim) or 'none'})")
+        raise SeriesError(f"'{word}' is {a_noun(dimension_name(udim))} ({unit}), but {field} is "
+                          f"{a_noun(dimension_name(field_dim))} (units: {_units_of(field_dim) or 'none'})")
     if field_dim is None:
         raise SeriesError(f"'{word}' has a unit ({unit}), but {field} is not a number with a unit: "
                           f"write the value alone")

@@ -63,7 +63,7 @@ CASES = [
      (3, 41, "the duration of 'for' needs a unit of time: write '0.4 s'")),
     ("for with a length",
      HEAD + "entity e { rules: r: topic /v.x > 1 for 3 m; }\nif (e.r) then { stop; }\n",
-     (3, 41, "the duration of 'for' must be a time, not a number (length)")),
+     (3, 41, "the duration of 'for' must be a time, not a length")),
     ("comparing time with length",
      HEAD + "entity e { rules: r: age(topic /x) > 3 m; }\nif (e.r) then { stop; }\n",
      (3, 36, "compares a time with a length")),
