@@ -141,6 +141,7 @@ class ActionRunner:
             held = dict(old._held)
         if not held:
             return
+        starts = False
         with self._cond:
             first = not self._active
             for ident, ctx in held.items():
@@ -149,8 +150,11 @@ class ActionRunner:
                     self._held[ident] = ctx
                     if (ident[0] not in leaving) if self.plugin.per_behaviour else first:
                         self._queue.append(("start", ctx))
-                        first = False
+                        starts, first = True, False
             self.plugin.active = True
+        if starts:  # its topic now, before the old runner leaves it: a lower action must not get it in between
+            self.claim()
+        with self._cond:
             self._cond.notify()
 
     def _compact(self) -> None:

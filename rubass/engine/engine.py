@@ -441,6 +441,7 @@ class Engine:
                     dst.rules[node.key] = src.rules[node.key]
             elif prev is not None and _same_ops(prev, node):  # edited: its `for`/`within`/`latch` keep
                 self._take_ops(prev, node)  # their history, so an edit that still holds releases nothing
+        self._take_renamed_rules(old, old_rules)
         old_behaviours = {n.behaviour.identity: n for n in old._nodes if n.behaviour}
         new_ones: List[_Node] = []
         for node in self._nodes:
@@ -464,6 +465,27 @@ class Engine:
         self._sync_actions()
         self.orphans = [n for n in old_behaviours.values() if n.active]
         return self.evaluate_all(now)
+
+    def _take_renamed_rules(self, old: "Engine", old_rules: Dict[str, _Node]) -> None:
+        """A rule new to this spec (a key the old one lacks: renamed, or its entity renamed) whose
+        signature is that of a rule the old spec had and this one lacks keeps that rule's value and
+        its `for`/`within`/`latch` state: a rename is not a new rule, and its stop must not be
+        released for a `for` time (found by an acceptance sweep)."""
+        keys = {n.key for n in self._nodes if not n.behaviour}
+        gone: Dict[str, _Node] = {}
+        for r in old.spec.rules:
+            if r.key not in keys and r.key in old_rules:
+                gone.setdefault(r.signature, old_rules[r.key])
+        if not gone:
+            return
+        for node in self._nodes:
+            if node.behaviour or node.key in old_rules:
+                continue
+            prev = gone.get(self.spec.rule(node.key).signature)
+            if prev is not None:
+                self._take_ops(prev, node)
+                if prev.key in old.store.rules:
+                    self.store.rules[node.key] = old.store.rules[prev.key]
 
     def _take_ops(self, src: _Node, dst: _Node) -> None:
         for a, b in zip(src.compiled.ops, dst.compiled.ops):

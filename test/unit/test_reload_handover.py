@@ -151,3 +151,55 @@ def test_a_new_behaviour_with_another_condition_counts_from_the_reload(monkeypat
     _, monitor = start("bstop: if (e.fast for 2 s) then { board_stop; }\n", {"board_stop": board}, [(1.0, 0.6)])
     new = swap(monitor, monkeypatch, "other: if (e.fast for 3 s) then { board_stop; }\n", 1.5, {"board_stop": board})
     assert new.next_deadline() == pytest.approx(4.5)  # another condition: no history taken
+
+
+@pytest.mark.parametrize("entity, rule", [("e", "hot2"), ("base", "hot")])  # the rule renamed, its entity renamed
+def test_a_renamed_rule_keeps_its_value_and_its_for(monkeypatch, entity, rule):
+    """An acceptance sweep: renaming a rule (or its entity) whose `for` held released the stop at the
+    reload for the whole `for` time, and a creep took the base meanwhile."""
+    text = ("action primitive board_stop, warn;\nentity {} {{ rules: {}: (topic /v.data > 0.5) for 0.5 s; }}\n"
+            "halt: if ({}.{}) then {{ board_stop; }}\n")
+    board = ActionRunner(Board("board_stop"), print)
+    engine = Engine(check_text(text.format("e", "hot", "e", "hot"), os.path.join(ROOT, "s.rbs"), [LIB]), 0.0)
+    engine.evaluate_all(0.0)
+    monitor = Monitor(engine, {"board_stop": board})
+    monitor._on_events(engine.on_message("/v", 1.0, {"data": 0.6}), "message")
+    run_to(engine, monitor, 1.5)
+    assert phases(board) == ["start"]
+    monkeypatch.setattr(reloading, "ros_now", lambda: 2.0)
+    new = Engine(check_text(text.format(entity, rule, entity, rule), os.path.join(ROOT, "s.rbs"), [LIB]), 2.0)
+    monitor._swap(engine, new, new.spec, {"board_stop": board})
+    assert new.active_behaviours() == [1] and phases(board) == ["start"], "released at the reload"
+
+
+def test_a_renamed_rule_with_a_for_keeps_its_count(monkeypatch):
+    head = "action primitive board_stop, warn;\nentity e {{ rules: {}: (topic /v.data > 0.5) for 2 s; }}\n"
+    text = "halt: if (e.{}) then {{ board_stop; }}\n"
+    engine = Engine(check_text(head.format("hot") + text.format("hot"), os.path.join(ROOT, "s.rbs"), [LIB]), 0.0)
+    engine.evaluate_all(0.0)
+    engine.on_message("/v", 1.0, {"data": 0.6})
+    new = Engine(check_text(head.format("hot2") + text.format("hot2"), os.path.join(ROOT, "s.rbs"), [LIB]), 1.5)
+    new.adopt(engine, 1.5)
+    assert new.next_deadline() == pytest.approx(3.0)  # counted since 1.0, not from the reload
+
+
+def test_a_stop_whose_definition_a_reload_changed_keeps_its_topic_from_a_lower_action():
+    """An acceptance sweep: a reload changing a held stop's `rate` let a creep (priority 1, same topic)
+    publish once: the old stop left its seat before the new one had started, and the arbiter handed
+    the topic to the creep. The new runner claims the topic as it adopts the old one's holders."""
+    from rubass.actions.arbitration import Arbiter
+    from rubass.actions.base import Context
+
+    arbiter, handed = Arbiter(), []
+    old_stop, new_stop, crawl = Board("stop"), Board("stop"), Board("crawl")
+    old_stop.seat = arbiter.seat("/base", "stop", 3, lambda: handed.append("old stop"))
+    crawl.seat = arbiter.seat("/base", "crawl", 1, lambda: handed.append("crawl"))
+    old_stop.seat.activate()
+    crawl.seat.activate()  # active under the stop, waiting
+    new_stop.seat = arbiter.seat("/base", "stop", 3, lambda: handed.append("new stop"))  # built by the reload
+    old, new = ActionRunner(old_stop, print), ActionRunner(new_stop, print)
+    old.submit("start", Context(1, 3, key=("sig", 1)))
+    new.adopt(old)
+    old_stop.seat.leave()  # the reload closes the runner it dropped
+    assert "crawl" not in handed, "the creep got the base between the two stops"
+    assert arbiter.owner("/base") is new_stop.seat and handed == ["new stop"]
