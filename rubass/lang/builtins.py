@@ -120,6 +120,12 @@ class BuiltinChecks:
             from .errors import did_you_mean
             self.error(ref.span, f"node '{ref.node}' is not in the nodes of entity '{self.scope.entity}' "  # type: ignore[attr-defined]
                                  f"({', '.join(nodes) or 'none declared'}){did_you_mean(ref.node, nodes)}")
+        elif nodes is None and self.scope.header_nodes and \
+                _norm_node(ref.node) not in _norm_nodes(self.scope.header_nodes):  # a behaviour's: no header of its own
+            from .errors import did_you_mean
+            self.warn(ref.span, f"node '{ref.node}' is in no entity's header ({', '.join(self.scope.header_nodes)}): "  # type: ignore[attr-defined]
+                                f"a misspelt node reads unknown for ever, and what it guards never fires"
+                                f"{did_you_mean(ref.node, self.scope.header_nodes)}")
         ty = {"alive": BOOL, "cpu": num(DIMENSIONLESS), "memory": num(MEMORY)}[e.func]
         return ast.NodeStat(ref.node, e.func, span=e.span), ty
 

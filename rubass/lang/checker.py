@@ -307,13 +307,15 @@ class _Checker:
     def check_behaviours(self, declared: Dict[str, Span], library: Dict[str, ActionDef]) -> List[CheckedBehaviour]:
         out: List[CheckedBehaviour] = []
         used: Set[str] = set()
+        header_nodes = tuple(sorted({n.name for ent in self.entities.values() for n in ent.nodes}))
         for d in self.spec.decls:
             if not isinstance(d, ast.Behaviour):
                 continue
             index = len(out) + 1
             uses = self.active_uses.setdefault(f"b:{index}", set())
             user = f"b:{index}"
-            scope = Scope(self.resolver(None, user), actions=self.declared_names, active_uses=uses, model=self.model)
+            scope = Scope(self.resolver(None, user), actions=self.declared_names, active_uses=uses, model=self.model,
+                          header_nodes=header_nodes)
             try:
                 cond = ExprChecker(scope, self.diags, self.warnings).condition(d.cond, "the condition of 'if'")
             except RecursionError:

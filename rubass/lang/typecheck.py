@@ -66,6 +66,7 @@ class Scope:
     actions: Optional[FrozenSet[str]] = None  # declared actions, for active()
     active_uses: Optional[Set[str]] = None  # filled with the actions active() names
     model: Optional[FieldModel] = None  # a system model: kinds and units of topic fields
+    header_nodes: Tuple[str, ...] = ()  # a behaviour's: every node the entities' headers list
 
 
 @dataclass

@@ -206,3 +206,19 @@ def test_articles_and_the_dimension_named():
 def test_the_hint_for_history_in_a_quantifier_names_the_operator_written(inner, hint):
     errors, _ = rule(f"any({inner})")
     assert len(errors) == 1 and errors[0][2].endswith(f"apply it to the quantifier instead, e.g. {hint}"), errors
+
+
+def test_a_node_in_a_behaviour_that_no_entity_header_lists_is_a_warning():
+    """An acceptance sweep: `if (cpu(node controler) > 80 %)` in a behaviour passed check with the
+    entity's node spelt `controller`: the stop reads unknown for ever. Behaviours have no header;
+    the entities' headers are the list a behaviour's node is checked against (a warning)."""
+    import os
+
+    from rubass.lang import check_text
+
+    from conftest import ROOT
+    spec = check_text("action primitive stop;\nentity e: controller { rules: dead: not alive(node controller); }\n"
+                      "if (cpu(node controler) > 80 %) then { stop; }\nif (alive(node /controller)) then { stop; }\n",
+                      "/tmp/s.rbs", [os.path.join(ROOT, "docs", "examples", "actions.yaml")])
+    warned = [w.message for w in spec.warnings if "no entity's header" in w.message]
+    assert len(warned) == 1 and "node 'controler'" in warned[0] and "did you mean 'controller'" in warned[0], warned
