@@ -38,3 +38,31 @@ def test_a_limit_never_reads_the_commands_of_another_type_taken_by_a_limit_besid
     # the stamped limit beside it reads them: clamped to its maximum once they ask for 1 m/s
     assert outb and outb[-1]["linear"]["x"] == pytest.approx(0.15), outb[-3:]
     assert "carries geometry_msgs/TwistStamped, not geometry_msgs/Twist" in ros.log(mon)
+
+
+def test_a_limit_released_with_the_stop_above_it_is_never_handed_the_topic(ros, tmp_path):
+    """An acceptance sweep: `then { crawl; stop; }` released together sent a creep command after the
+    stop's on_release in 10 of 20 cycles: the stop's seat went before the crawl's release had run on
+    its thread, so the arbiter handed the crawl the topic for one planner command."""
+    (tmp_path / "lib.yaml").write_text(
+        "actions:\n"
+        "  stop: {plugin: publish, topic: /base, type: geometry_msgs/Twist, message: {}, rate: 20 Hz,\n"
+        "         on_release: {linear: {y: 9.0}}, priority: 3}\n"
+        "  crawl: {plugin: limit, input: /nav, topic: /base, linear_x: [-0.1 m/s, 0.1 m/s], priority: 1}\n")
+    path = tmp_path / "s.rbs"
+    path.write_text('import "lib.yaml";\naction primitive stop, crawl;\nentity s { rules: both: topic /b.data > 1; }\n'
+                    "together: if (s.both) then { crawl; stop; }\n")
+    ros.monitor(str(path))
+    cycle = [{"publish": "/b", "msg": {"data": 2.0}},
+             {"publish": "/nav", "msg": {"linear": {"x": 0.5}}, "repeat": 15, "period": 0.01},
+             {"publish": "/b", "msg": {"data": 0.0}},
+             {"publish": "/nav", "msg": {"linear": {"x": 0.5}}, "repeat": 15, "period": 0.01}]
+    rec = ros.probe({
+        "listen": [{"topic": "/base", "type": TWIST}],
+        "advertise": [{"topic": "/nav", "type": TWIST}, {"topic": "/b", "type": "std_msgs/Float64"}],
+        "steps": [{"wait_subscribers": "/nav"}, {"wait_subscribers": "/b"}, {"wait_publishers": "/base"},
+                  {"sleep": 0.5}] + cycle * 12 + [{"sleep": 0.2}],
+        "linger": 0.1})
+    base = [r["msg"]["linear"] for r in rec if r["kind"] == "recv" and r["topic"] == "/base"]
+    assert sum(m["y"] == 9.0 for m in base) == 12, "one on_release per cycle"
+    assert not [m for m in base if m["x"] != 0.0], "the crawl published though the stop was always above it"

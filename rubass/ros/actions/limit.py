@@ -72,9 +72,9 @@ class LimitPlugin(ActionPlugin):
         _LATEST[(self.input, self.type)] = (raw._buff, now)
         self._input_ok()
         with self._lock:
-            if not self._on:  # decoded only if a start needs it
-                self._raw, self._raw_at = raw._buff, now
-                return
+            if not (self._on and self.active):  # decoded only if a start needs it; `active` goes false as its
+                self._raw, self._raw_at = raw._buff, now  # release is dispatched (a stop released with it
+                return  # must not hand it the topic for one command before its release runs)
             msg = self._clamped(raw._buff)
             if msg is None:
                 return
@@ -97,7 +97,7 @@ class LimitPlugin(ActionPlugin):
 
     def periodic(self) -> None:
         with self._lock:
-            if not self._on:
+            if not (self._on and self.active):  # released (dispatched), its release not yet run: nothing more
                 return
             now = time.monotonic()
             if self._due or now - self._raw_at > self.timeout or now - self._pub_at >= 0.9 * self.period:
