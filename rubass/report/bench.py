@@ -99,6 +99,10 @@ def from_json_lines(path: str) -> Reaction:
         if not all(math.isfinite(f) and f >= 0 for f in figures):
             raise BenchError(f"{path}:{number}: a reaction figure is not a finite, non-negative number: no upper "
                              f"bound; measure again")
+        if not figures[2] <= figures[1] <= figures[0]:  # a max below a percentile is no worst case
+            raise BenchError(f"{path}:{number}: the figures are out of order (p50 {figures[2]:g} ms, p99 "
+                             f"{figures[1]:g} ms, max {figures[0]:g} ms; each must be at most the next): no upper "
+                             f"bound; measure again")
         worst, p99, p50 = max(worst, figures[0]), max(p99, figures[1]), max(p50, figures[2])
         n += 1
     if not n:

@@ -121,6 +121,7 @@ def build_matrix(ev: Evidence) -> None:
             users = [b for b in spec.behaviours if r.key in uses[b.index]]
             ids = list(rule_ids_of(spec, r))
             row = _row(h, r.key, [behaviour_label(spec, b.index) for b in users], ids, outcomes, not users)
+            row.gaps += _uncovered_rules(spec, _rules_used(spec, ast.RuleRef(r.key)) - {r.key}, outcomes)
             if outcomes and not any(r.key in o.rules_true for o in outcomes):
                 row.gaps.append("never true in any test")  # as the coverage's "rules never true"
             ev.matrix.append(row)
@@ -129,6 +130,7 @@ def build_matrix(ev: Evidence) -> None:
                 continue  # shown with its rule
             ids = list(attrs(b).get("id", ()))
             row = _row(h, None, [behaviour_label(spec, b.index)], ids, outcomes, False)
+            row.gaps += _uncovered_rules(spec, uses[b.index], outcomes)
             if outcomes and not any(b.index in o.started for o in outcomes):
                 row.gaps.append("never started in any test")  # as the coverage's "behaviours never started"
             ev.matrix.append(row)
@@ -183,6 +185,18 @@ def _row(h: Hazard, rule: Optional[str], behaviours: List[str], ids: List[str], 
     if ids and not covering(outcomes, [h.id]):
         gaps.append(f"no test covers hazard {h.id}")
     return Row(h, rule, behaviours, tests, gaps + _failing(tests))
+
+
+def _uncovered_rules(spec: CheckedSpec, keys: Set[str], outcomes: List[Outcome]) -> List[str]:
+    """A gap for each rule in `keys` (the rules a row's rule or behaviour uses) whose ids no test covers:
+    the coverage lists it, so the row that rests on it is not covered (a rule with no id is covered with
+    the row it serves)."""
+    out = []
+    for key in sorted(keys):
+        ids = list(rule_ids_of(spec, spec.rule(key)))
+        if ids and not covering(outcomes, ids):
+            out.append(f"no test covers {' or '.join(ids)} (rule {key}, used here)")
+    return out
 
 
 def _failing(tests: List[Outcome]) -> List[str]:

@@ -12,6 +12,7 @@ from typing import Any, Dict, List, Optional, Tuple
 import yaml
 
 from ..lang.errors import RubassError
+from ..testing.yamlpos import whole_text
 
 STR = "tag:yaml.org,2002:str"
 NULL = "tag:yaml.org,2002:null"
@@ -60,12 +61,41 @@ def read_hazards(path: str) -> List[Hazard]:
         raise HazardsError([f"{where}: error: not valid YAML: {exc.problem or exc.context}{opened}"]) from None
     except yaml.YAMLError as exc:
         raise HazardsError([f"{path}: error: not valid YAML: {exc}"]) from None
+    lone = _lone_surrogates(root)
+    if lone:
+        raise HazardsError([f"{path}:{n.start_mark.line + 1}:{n.start_mark.column + 1}: error: a text holds a lone "
+                            f"surrogate (an escape such as \\uD800 that is no character): write the character itself"
+                            for n in lone])
     reader = _Reader(path)
     out = reader.table(root)
     if reader.errors:
         n = len(reader.errors)
         raise HazardsError(reader.errors + ([f"{path}: {n} errors"] if n > 1 else []))
     return out
+
+
+def _lone_surrogates(root: Optional[yaml.Node]) -> List[yaml.Node]:
+    """The text scalars holding a lone surrogate (`"\\uD800"`): no character, the page could not be written;
+    an escaped pair is made its character in place."""
+    out: List[yaml.Node] = []
+    stack = [root] if root is not None else []
+    seen = set()
+    while stack:
+        node = stack.pop()
+        if id(node) in seen:  # an alias: the node again
+            continue
+        seen.add(id(node))
+        if isinstance(node, yaml.ScalarNode):
+            text = whole_text(node.value)
+            if text is None:
+                out.append(node)
+            else:
+                node.value = text
+        elif isinstance(node, yaml.MappingNode):
+            stack.extend(n for pair in node.value for n in pair)
+        elif isinstance(node, yaml.SequenceNode):
+            stack.extend(node.value)
+    return sorted(out, key=lambda n: (n.start_mark.line, n.start_mark.column))
 
 
 def text_line(data: bytes, offset: int) -> int:
@@ -190,6 +220,6 @@ def _kind(node: yaml.Node) -> str:
     if node.tag == NULL:
         return "empty"
     if node.tag == STR:
-        return "a text"
+        return "a text" if node.value.strip() else "an empty text"  # `title: ""`, `plr: "  "`
     kind = node.tag.rsplit(":", 1)[-1]
     return {"int": "a number", "float": "a number", "bool": "true/false"}.get(kind, f"a {kind}")

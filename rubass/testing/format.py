@@ -3,6 +3,7 @@ from __future__ import annotations
 
 import math
 import os
+import re
 from typing import Any, Callable, Dict, List, Tuple, TypeVar
 
 from ..lang.errors import did_you_mean
@@ -17,6 +18,7 @@ MAX_TIME = 24 * 3600.0  # a test simulates at most a day (ticks at 50 Hz: 4.3 mi
 MAX_MESSAGES = 1_000_000  # per test: each is a real message object
 _CHECK_EPOCH = 1000.0  # test time 0 when a message's header stamp is checked (any such time does)
 T = TypeVar("T")
+_BARE_NUMBER = re.compile(r"\s*[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?\s*")  # no unit: the default one
 
 
 class _Reader:
@@ -66,8 +68,10 @@ class _Reader:
             q: Any = (float(value), dim)
         else:
             q = parse_quantity(str(value))
-            if q is not None and q[1] == ():
-                q = (q[0], dim) if dim != () else q
+            if q is not None and q[1] == () and dim != ():
+                if not _BARE_NUMBER.fullmatch(str(value)):  # `50 %`: a share is no time, rate or size
+                    raise self.fail(line, f"{what}: '{value}' is a share, not a quantity in {unit}")
+                q = (q[0], dim)  # only a bare number takes the default unit
         if q is None or q[1] != dim or not math.isfinite(q[0]):
             raise self.fail(line, f"{what}: '{value}' is not a (finite) quantity in {unit}")
         if q[0] < 0 and not negative:
@@ -182,7 +186,11 @@ class _Reader:
                                     f"see it; lengthen duration or end the expectation by {duration:g} s")
 
     def topic(self, case: Case, topic: str, value: Any, line: int) -> None:
-        if not topic.startswith("/"):
+        if topic.startswith("~"):  # the monitor's private name, as the spec's `~x` resolves (docs/testing.md)
+            from ..lang.topicnames import resolve
+
+            topic = resolve(topic)
+        elif not topic.startswith("/"):
             topic = "/" + topic
         t = self.mapping(value, line, f"topic {topic}", ("type", "rate", "start", "field", "fields", "values",
                                                          "messages"))

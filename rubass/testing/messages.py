@@ -142,6 +142,18 @@ def _a(slot: str) -> str:
     return f"{'an' if slot[:1] in 'aeio' else 'a'} {slot}"
 
 
+def seconds(value: Any) -> Any:
+    """A time written with a unit (`500 ms`, `"0.6 s"`, as series and `at` take them) as its number of
+    seconds; any other value as it is (the setter says what is wrong with it)."""
+    if isinstance(value, str):
+        from ..lang.units import TIME, parse_quantity
+
+        q = parse_quantity(value)
+        if q is not None and (q[1] == TIME or (q[1] == () and re.fullmatch(r"\s*[-+.\d][\d.eE+-]*\s*", value))):
+            return q[0]
+    return value
+
+
 def _scalar(slot: str, value: Any, where: str) -> Any:
     if slot in _FLOATS:
         if isinstance(value, str) and value.strip().lower() in _NON_FINITE:  # as in series (TESTING.md)
@@ -171,8 +183,10 @@ def _scalar(slot: str, value: Any, where: str) -> Any:
     if slot in ("time", "duration"):
         import genpy
 
+        value = seconds(value)
         if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
-            raise MessageError(f"{where} is {_a(slot)}: {value!r} is not a number of seconds")
+            raise MessageError(f"{where} is {_a(slot)}: {value!r} is not a number of seconds (or a time "
+                               f"such as 500 ms)")
         try:
             return (genpy.Time if slot == "time" else genpy.Duration).from_sec(float(value)) if value else \
                 (genpy.Time() if slot == "time" else genpy.Duration())
@@ -251,6 +265,7 @@ _STAMP = ("header", "stamp")
 
 def _absolute(stamp: Any, epoch: float) -> Any:
     """A header stamp in test time as the engine's absolute time; 0 stays the zero stamp."""
+    stamp = seconds(stamp)
     if isinstance(stamp, (int, float)) and not isinstance(stamp, bool) and stamp != 0:
         if stamp < 0:
             raise MessageError(f"'header.stamp' is a time (test time in seconds): {stamp!r} is before the "

@@ -21,6 +21,7 @@ _QUOTED_WORD = re.compile(rf"({_QUOTED})(\S*)")
 _RAMP = re.compile(rf"({_NUM})([-+](?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)x(\d+)")
 _REPEAT = re.compile(r"(.+)x(\d+)")
 _MAX_STEPS = 10_000_000
+_BAD_COUNT = re.compile(rf".+x({_NUM})")  # xN with N a number that is no whole count
 
 
 class SeriesError(RubassError, ValueError):
@@ -115,6 +116,10 @@ def _word(word: str, field_dim: Any, field: str) -> List[Any]:
     m = _REPEAT.fullmatch(word)
     if m:
         return _repeat(word, GAP if m.group(1) == "_" else value(m.group(1), field_dim, field), int(m.group(2)))
+    m = _BAD_COUNT.fullmatch(word)
+    if m:  # `0x1.5`, `0x-2`, `_x2e1`: a count, but not a whole one
+        raise SeriesError(f"'{word}': N in xN (how many times) must be a whole number of at least 1, "
+                          f"not {m.group(1)}")
     return [value(word, field_dim, field)]
 
 

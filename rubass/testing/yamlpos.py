@@ -1,7 +1,7 @@
 """YAML with line numbers: mappings and lists remember where they and their items are."""
 from __future__ import annotations
 
-from typing import Any, Dict, List
+from typing import Any, Dict, List, Optional
 
 import yaml
 
@@ -85,7 +85,30 @@ def _sequence(loader: _Loader, node: yaml.SequenceNode) -> LList:
     return out
 
 
+def whole_text(text: str) -> Optional[str]:
+    """`text` with each escaped surrogate pair (`"\\uD83D\\uDE00"`) made its character; None when it holds a
+    lone surrogate (`"\\uD800"`): no character, so it can be neither printed nor written as UTF-8."""
+    try:
+        text.encode("utf-8")
+        return text
+    except UnicodeEncodeError:
+        pass
+    try:
+        return text.encode("utf-16-le", "surrogatepass").decode("utf-16-le")
+    except UnicodeDecodeError:
+        return None
+
+
+def _str(loader: _Loader, node: yaml.ScalarNode) -> str:
+    text = whole_text(loader.construct_scalar(node))
+    if text is None:
+        raise TestFileError("", node.start_mark.line + 1, "a text holds a lone surrogate (an escape such as "
+                                                          "\\uD800 that is no character): write the character itself")
+    return text
+
+
 _Loader.add_constructor(yaml.resolver.BaseResolver.DEFAULT_MAPPING_TAG, _mapping)
+_Loader.add_constructor("tag:yaml.org,2002:str", _str)
 _Loader.add_constructor(yaml.resolver.BaseResolver.DEFAULT_SEQUENCE_TAG, _sequence)
 
 

@@ -69,7 +69,7 @@ tests:
         - {{at: 3 s, alive: true, memory: 50000000}}
     expect:
       - {{at: 1 s, start: b_fat}}
-      - {{at: 3 s, release: b_fat}}
+      - {{at: 2 s, release: b_fat}}  # dead at 2 s: its memory unknown, as live
       - {{at: 2 s, start: b_dead}}
       - {{at: 3 s, release: b_dead}}
 """)
