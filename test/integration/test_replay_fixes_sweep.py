@@ -4,17 +4,15 @@ with the rosbag API (no master): node samples under another spelling, every reco
 checked, the spec's warnings, a recording spanning days, a bag given as the spec."""
 import json
 import os
-import random
 import subprocess
 import sys
 
 import pytest
 
-from rubass.engine import Engine
 from rubass.lang import check_text
 from rubass.replay.agents import agent_samples
 from rubass.replay.command import _sampled_nodes
-from rubass.replay.run import _node_sample, replay as replay_loop, resolve_node
+from rubass.replay.run import replay as replay_loop, resolve_node
 
 from conftest import ROOT
 
@@ -128,91 +126,6 @@ def test_messages_of_different_topics_at_one_instant_stay_one_evaluation():
            (START + 2, "/y", {"v": 2.0}), (START + 2, "/x", {"v": 0.0})]
     _, events = replay_loop(over_spec(), iter(seq), START, START + 3.0)
     assert not [e for e in events if e.kind == "start" and e.behaviour == 2]
-
-
-SPEC = """action primitive stop, warn;
-entity r: /p; { rules:
-  a: topic /x.v > 1;
-  c: (topic /x.v > 2) for 0.2 s;
-  g: age(topic /y) > 0.3 s;
-  n: cpu(node /p) > 0.5 and topic /y.v > 0;
-  f: frequency(topic /y) < 20 Hz;
-}
-if (r.a and not r.c) then { warn; }
-if (r.g or r.n) then { stop; }
-if (r.f) then { warn; }
-"""
-
-
-def reference(spec, messages, start, end, rate=50.0, node_topics=()):
-    """A straightforward loop: messages of different topics at one timestamp together, a second message
-    of a topic in the batch after it (docs/replay.md)."""
-    node_topics = set(node_topics)
-    engine = Engine(spec, 0.0, origin=start)
-    events = engine.evaluate_all(0.0)
-    period = 1.0 / rate
-    state = {"next_tick": period, "batch_time": 0.0}
-    batch = []
-
-    def flush():
-        if batch:
-            events.extend(engine.on_messages(state["batch_time"], batch))
-            batch.clear()
-
-    def ticks_until(t, inclusive):
-        while state["next_tick"] < t or (inclusive and state["next_tick"] == t):
-            events.extend(engine.on_tick(state["next_tick"]))
-            state["next_tick"] = round((state["next_tick"] + period) / period) * period
-
-    for stamp, topic, msg in messages:
-        t = stamp - start
-        if topic in node_topics:
-            flush()
-            ticks_until(t, inclusive=False)
-            sample = _node_sample(msg)
-            if sample is not None:
-                at = max(min(t, sample[4] - start), engine.store.now) if sample[4] is not None else t
-                events.extend(engine.on_node_sample(sample[0], at, *sample[1:4]))
-            continue
-        if batch and (t != state["batch_time"] or any(name == topic for name, _ in batch)):
-            flush()
-        if not batch:
-            ticks_until(t, inclusive=False)
-            state["batch_time"] = t
-        batch.append((topic, msg))
-    flush()
-    ticks_until(end - start, inclusive=True)
-    events.extend(engine.advance(end - start))
-    return engine, events
-
-
-def test_the_loop_gives_the_events_of_the_reference_loop():
-    rnd = random.Random(17)
-    spec = check_text(SPEC, os.path.join(ROOT, "x.rbs"), [LIB])
-    shared = 0
-    for case in range(25):
-        t, seq = START + rnd.choice([0.0, -0.05, 0.02]), []
-        for _ in range(250):
-            step = rnd.choice([0.0, 0.0, 0.004, 0.02, 0.05, 0.4])
-            t += step
-            kind = rnd.random()
-            if kind < 0.4:
-                shared += bool(seq) and step == 0.0 and seq[-1][1] == "/x"
-                seq.append((t, "/x", {"v": rnd.choice([0, 1.5, 2.2, 3])}))
-            elif kind < 0.8:
-                seq.append((t, "/y", {"v": rnd.choice([-0.5, 0, 0.5])}))
-            else:
-                at = rnd.choice([None, t - 0.01, t + 0.01])
-                seq.append((t, "/mon/node_samples", Sample(json.dumps(
-                    {"node": "/p", "alive": True, "cpu": rnd.choice([0.2, 0.7]), "time": at}))))
-        end = t + rnd.choice([0.0, 0.5])
-        rate = rnd.choice([50.0, 7.0, 200.0])
-        got = replay_loop(spec, iter(seq), START, end, rate, ["/mon/node_samples"])
-        want = reference(spec, iter(seq), START, end, rate, ["/mon/node_samples"])
-        assert [(e.time, e.kind, e.behaviour, e.rule, e.value) for e in got[1]] == \
-            [(e.time, e.kind, e.behaviour, e.rule, e.value) for e in want[1]], case
-        assert got[0].store.rules == want[0].store.rules
-    assert shared > 50  # the recordings have messages of one topic at one instant
 
 
 # -- the command, on recorded bags -----------------------------------------------------------------

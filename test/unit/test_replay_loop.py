@@ -80,12 +80,15 @@ def test_the_loop_gives_the_events_of_the_reference_loop():
     rnd = random.Random(17)
     spec = check_text(SPEC, os.path.join(ROOT, "x.rbs"), [LIB])
     start = 1700000000.0
+    shared = 0  # messages of one topic at one instant: each is evaluated (docs/replay.md)
     for case in range(25):
         t, seq = start + rnd.choice([0.0, -0.05, 0.02]), []
         for _ in range(250):
-            t += rnd.choice([0.0, 0.0, 0.004, 0.02, 0.05, 0.4])
+            step = rnd.choice([0.0, 0.0, 0.004, 0.02, 0.05, 0.4])
+            t += step
             kind = rnd.random()
             if kind < 0.4:
+                shared += bool(seq) and step == 0.0 and seq[-1][1] == "/x"
                 seq.append((t, "/x", {"v": rnd.choice([0, 1.5, 2.2, 3])}))
             elif kind < 0.8:
                 seq.append((t, "/y", {"v": rnd.choice([-0.5, 0, 0.5])}))
@@ -100,3 +103,4 @@ def test_the_loop_gives_the_events_of_the_reference_loop():
         assert _events(got) == _events(want), case
         assert got[0].store.rules == want[0].store.rules
     assert any(e[1] == "start" for e in _events(got))
+    assert shared > 50
