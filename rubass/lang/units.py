@@ -1,6 +1,8 @@
 """Physical units: the table of LANGUAGE.md §7, normalised to SI, with dimensions."""
 from __future__ import annotations
 
+import math
+
 from typing import Dict, Optional, Tuple
 
 from .errors import a_noun
@@ -111,11 +113,14 @@ def parse_quantity(text: str) -> Optional[Tuple[float, Dimension]]:
         return None
     value = float(m.group(1))
     if not m.group(2):
-        return value, DIMENSIONLESS
+        return (value, DIMENSIONLESS) if math.isfinite(value) else None
     unit = UNITS.get(m.group(2))
     if unit is None:
         return None
-    return value * unit[0], unit[1]
+    si = value * unit[0]
+    if not math.isfinite(si) or (si == 0.0 and value != 0.0):  # 1e308 h is no timeout; 1e-322 us no zero
+        return None
+    return si, unit[1]
 
 
 # other spellings of units, to suggest the unit itself ('sec' is a unit too, but 'm/sec' is not)

@@ -222,3 +222,19 @@ def test_a_node_in_a_behaviour_that_no_entity_header_lists_is_a_warning():
                       "/tmp/s.rbs", [os.path.join(ROOT, "docs", "examples", "actions.yaml")])
     warned = [w.message for w in spec.warnings if "no entity's header" in w.message]
     assert len(warned) == 1 and "node 'controler'" in warned[0] and "did you mean 'controller'" in warned[0], warned
+
+
+def test_a_library_quantity_that_overflows_in_si_units_is_an_error(tmp_path):
+    """`timeout: 1e308 h` was an infinite timeout (a hung service never found); `1e-322 us` a zero."""
+    from rubass.lang import SpecError, load_spec
+    from rubass.lang.units import parse_quantity
+
+    assert parse_quantity("1e308 h") is None and parse_quantity("1e-322 us") is None
+    assert parse_quantity("1e999") is None and parse_quantity("2 s") == (2.0, parse_quantity("1 s")[1])
+    (tmp_path / "lib.yaml").write_text("actions:\n  svc: {plugin: service, service: /x, type: std_srvs/Trigger, "
+                                       "timeout: 1e308 h}\n")
+    (tmp_path / "s.rbs").write_text('import "lib.yaml";\naction primitive svc;\n'
+                                    "entity e { rules: r: topic /v.data > 1; }\nif (e.r) then { svc; }\n")
+    with pytest.raises(SpecError) as info:
+        load_spec(str(tmp_path / "s.rbs"))
+    assert "'timeout' must be a positive time such as '1 s', got '1e308 h'" in info.value.render()
