@@ -330,10 +330,13 @@ class Monitor(Reloading):
             if was and not self.error_guard.active:
                 self.keeper.save(loop.engine, self.dispatcher.orphans, self._fail_safes())
 
-    def _sampler(self, spec: CheckedSpec) -> NodeSampler:
+    def _sampler(self, spec: CheckedSpec, previous: Optional[NodeSampler] = None) -> NodeSampler:
+        """The node sampler of `spec`'s nodes; `previous`: the one a reload replaces (what it knew is kept)."""
         nodes = [(n, rospy.resolve_name(n)) for n in sorted(spec.nodes)]
         sampler = NodeSampler(nodes, self._on_node, _ros_now, 1.0 / self.config.node_rate, rospy.get_name())
         sampler.remote = lambda node, host, pid: self.agents.lookup(node, host, pid, time.monotonic())
+        if previous is not None:
+            sampler.carry(previous)
         sampler.start()
         return sampler
 

@@ -173,6 +173,17 @@ class NodeSampler:
         self._masters: Dict[int, rpc.Caller] = {}  # a kept connection to the master per sampling thread
         self._masters_lock = threading.Lock()
 
+    def carry(self, old: "NodeSampler") -> None:
+        """What the sampler this one replaces (a reload changed the node set) knew of the nodes both
+        watch: where each is, its pid, and which the master did not know. A reload while the master
+        is away must read them as before, not unknown (a never-registered lidar's stop was released)."""
+        for name in self.status:
+            for mine, theirs in ((self._uris, old._uris), (self._pids, old._pids), (self._looked_up, old._looked_up)):
+                if name in theirs:
+                    mine[name] = theirs[name]  # type: ignore[index]
+            if name in old._unregistered:
+                self._unregistered.add(name)
+
     def start(self) -> None:
         if self.status:
             self._thread = threading.Thread(target=self._run, name="rubass-nodes", daemon=True)

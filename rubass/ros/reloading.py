@@ -150,7 +150,7 @@ class Reloading:
             self.watcher.sync(spec)
             if spec.nodes != self.spec.nodes:
                 self.sampler.stop()
-                self.sampler = self._sampler(spec)
+                self.sampler = self._sampler(spec, self.sampler)
             dropped = [r for n, r in self.runners.items() if runners.get(n) is not r]
             self.retired_failures += sum(r.stats.failures for r in dropped)  # the record is since start
             self.spec, self.runners = spec, runners

@@ -344,3 +344,20 @@ def test_a_node_never_asked_about_is_unknown_while_the_master_cannot_be_reached(
     st = NodeStatus("driver", "/driver")
     sampler.sample(st)
     assert st.alive is UNKNOWN and "never seen" in st.why
+
+
+def test_a_reload_that_changes_the_nodes_keeps_what_the_sampler_knew(monkeypatch):
+    """The review: a reload adding a node while the master was away built a new sampler that knew
+    nothing, and the never-registered lidar read unknown again, releasing its stop."""
+    calls = []
+    answers = {("http://master:11311/", "lookupNode"): [-1, "unknown node [/driver]", ""]}
+    old = _fake_sampler(answers, calls, monkeypatch)
+    old.sample(old.status["/driver"])
+    answers[("http://master:11311/", "lookupNode")] = ConnectionRefusedError("refused")  # the master goes away
+    new = NodeSampler([("driver", "/driver"), ("camera", "/camera")], lambda *a: None, lambda: 1.0, 0.1, "/rubass")
+    new.master_uri, new._is_local = old.master_uri, old._is_local
+    new.carry(old)
+    new.sample(new.status["/driver"])
+    new.sample(new.status["/camera"])
+    assert new.status["/driver"].alive is False, new.status["/driver"].why
+    assert new.status["/camera"].alive is UNKNOWN  # never asked about: unknown, as before
