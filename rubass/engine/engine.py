@@ -12,7 +12,8 @@ from __future__ import annotations
 import heapq
 import itertools
 import math
-from typing import AbstractSet, Any, Dict, FrozenSet, Iterable, List, Optional, Set, Tuple
+import re
+from typing import AbstractSet, Any, Callable, Dict, FrozenSet, Iterable, List, Optional, Set, Tuple
 
 from ..lang import ast
 from ..lang.fmt import format_expr
@@ -441,7 +442,7 @@ class Engine:
                     dst.rules[node.key] = src.rules[node.key]
             elif prev is not None and _same_ops(prev, node):  # edited: its `for`/`within`/`latch` keep
                 self._take_ops(prev, node)  # their history, so an edit that still holds releases nothing
-        self._take_renamed_rules(old, old_rules)
+        renames = self._take_renamed_rules(old, old_rules)
         old_behaviours = {n.behaviour.identity: n for n in old._nodes if n.behaviour}
         new_ones: List[_Node] = []
         for node in self._nodes:
@@ -457,7 +458,7 @@ class Engine:
                 if node.active:
                     for a in node.actions:
                         self._holders.setdefault(a, set()).add(node.key)
-        _take_condition_history(self, new_ones, list(old_behaviours.values()))
+        _take_condition_history(self, new_ones, list(old_behaviours.values()), renames)
         for action, holders in old._holders.items():
             outside = {h for h in holders if not h.startswith("b:")}
             if outside:
@@ -466,26 +467,28 @@ class Engine:
         self.orphans = [n for n in old_behaviours.values() if n.active]
         return self.evaluate_all(now)
 
-    def _take_renamed_rules(self, old: "Engine", old_rules: Dict[str, _Node]) -> None:
+    def _take_renamed_rules(self, old: "Engine", old_rules: Dict[str, _Node]) -> Dict[str, str]:
         """A rule new to this spec (a key the old one lacks: renamed, or its entity renamed) whose
-        signature is that of a rule the old spec had and this one lacks keeps that rule's value and
-        its `for`/`within`/`latch` state: a rename is not a new rule, and its stop must not be
-        released for a `for` time (found by an acceptance sweep)."""
+        signature is that of a rule the old spec had and this one lacks, once the rules it uses are
+        renamed too, keeps that rule's value and its `for`/`within`/`latch` state: a rename is not a
+        new rule, and its stop must not be released for a `for` time (found by an acceptance sweep).
+        Returns the renames found (old key -> new key), in dependency order."""
         keys = {n.key for n in self._nodes if not n.behaviour}
-        gone: Dict[str, _Node] = {}
-        for r in old.spec.rules:
-            if r.key not in keys and r.key in old_rules:
-                gone.setdefault(r.signature, old_rules[r.key])
-        if not gone:
-            return
-        for node in self._nodes:
+        gone = [(r.key, r.signature) for r in old.spec.rules if r.key not in keys and r.key in old_rules]
+        renames: Dict[str, str] = {}
+        for node in self._nodes if gone else ():
             if node.behaviour or node.key in old_rules:
                 continue
-            prev = gone.get(self.spec.rule(node.key).signature)
-            if prev is not None:
-                self._take_ops(prev, node)
-                if prev.key in old.store.rules:
-                    self.store.rules[node.key] = old.store.rules[prev.key]
+            sig, rename = self.spec.rule(node.key).signature, _renamer(renames)
+            for key, old_sig in gone:
+                if key not in renames and rename(old_sig) == sig:
+                    prev = old_rules[key]
+                    self._take_ops(prev, node)
+                    if key in old.store.rules:
+                        self.store.rules[node.key] = old.store.rules[key]
+                    renames[key] = node.key
+                    break
+        return renames
 
     def _take_ops(self, src: _Node, dst: _Node) -> None:
         for a, b in zip(src.compiled.ops, dst.compiled.ops):
@@ -584,21 +587,34 @@ _INSTANT_OPS = (ForOp, WithinOp, LatchOp)  # operators whose value moves only at
 _NO_FIELDS: FrozenSet[int] = frozenset()  # a tick, a deadline, a node sample: no field changed
 
 
-def _take_condition_history(engine: Engine, new_ones: List[_Node], gone: List[_Node]) -> None:
+def _take_condition_history(engine: Engine, new_ones: List[_Node], gone: List[_Node], renames: Dict[str, str]) -> None:
     """A behaviour new to this spec whose condition reads as one the old spec's behaviours no longer
-    have (renamed, its actions changed): its `for`/`within`/`latch` keep that one's history, so a
-    stop that held goes on (it starts at once, and the old one is released after it), not a `for`
-    time later, and a `within`'s minimum hold is not cut short by a rename."""
+    have (renamed, its actions changed; the rules it names read under their new names): its
+    `for`/`within`/`latch` keep that one's history, so a stop that held goes on (it starts at once,
+    and the old one is released after it), not a `for` time later, and a `within`'s minimum hold is
+    not cut short by a rename."""
     if not new_ones or not gone:
         return
+    rename = _renamer(renames)
     by_text: Dict[str, _Node] = {}
     for prev in gone:
         if prev.compiled.ops:
-            by_text.setdefault(format_expr(prev.behaviour.cond), prev)  # type: ignore[union-attr]
+            by_text.setdefault(rename(format_expr(prev.behaviour.cond)), prev)  # type: ignore[union-attr]
     for node in new_ones:
         prev = by_text.get(format_expr(node.behaviour.cond)) if node.compiled.ops else None  # type: ignore[union-attr]
         if prev is not None and _same_ops(prev, node):
             engine._take_ops(prev, node)
+
+
+def _renamer(renames: Dict[str, str]) -> Callable[[str], str]:
+    """A function that writes a rule's or condition's canonical text with renamed rule keys (`e.fast`
+    -> `base.fast`) in their new names: a key only as a whole name, not inside a topic, a field path
+    or a longer name."""
+    if not renames:
+        return lambda text: text
+    keys = re.compile(r"(?<![\w/.])(" + "|".join(re.escape(k) for k in sorted(renames, key=len, reverse=True))
+                      + r")(?![\w])")
+    return lambda text: keys.sub(lambda m: renames[m.group(1)], text)
 
 
 def _same_ops(a: _Node, b: _Node) -> bool:

@@ -203,3 +203,32 @@ def test_a_stop_whose_definition_a_reload_changed_keeps_its_topic_from_a_lower_a
     old_stop.seat.leave()  # the reload closes the runner it dropped
     assert "crawl" not in handed, "the creep got the base between the two stops"
     assert arbiter.owner("/base") is new_stop.seat and handed == ["new stop"]
+
+
+@pytest.mark.parametrize("behaviour", ["halt: if ({ent}.hot) then {{ board_stop; }}",  # a rule using a sibling
+                                       "if ({ent}.fast for 0.5 s) then {{ board_stop; }}"])  # unnamed, its own for
+def test_an_entity_renamed_keeps_the_for_of_rules_using_their_siblings(monkeypatch, behaviour):
+    """The review: renaming an entity changed the signature of every rule that uses a sibling (`e.fast`
+    became `base.fast` in it), and the text of an unnamed behaviour's condition: the stop was released
+    at the reload for its `for` time. Renamed keys are read under their new names before comparing."""
+    text = ("action primitive board_stop, warn;\nentity {ent} {{ rules: fast: topic /v.data > 0.5; "
+            "hot: fast for 0.5 s; }}\n" + behaviour + "\n")
+    board = ActionRunner(Board("board_stop"), print)
+    engine = Engine(check_text(text.format(ent="e"), os.path.join(ROOT, "s.rbs"), [LIB]), 0.0)
+    engine.evaluate_all(0.0)
+    monitor = Monitor(engine, {"board_stop": board})
+    monitor._on_events(engine.on_message("/v", 1.0, {"data": 0.6}), "message")
+    run_to(engine, monitor, 1.5)
+    assert phases(board) == ["start"]
+    monkeypatch.setattr(reloading, "ros_now", lambda: 2.0)
+    new = Engine(check_text(text.format(ent="base"), os.path.join(ROOT, "s.rbs"), [LIB]), 2.0)
+    monitor._swap(engine, new, new.spec, {"board_stop": board})
+    assert new.active_behaviours() == [1] and phases(board) == ["start"], "released at the reload"
+
+
+def test_a_renamed_key_is_replaced_only_as_a_whole_name():
+    from rubass.engine.engine import _renamer
+
+    rename = _renamer({"e.fast": "base.fast"})
+    assert rename("e.fast for 0.5 [e.fast: topic /e.fast > 1]") == "base.fast for 0.5 [base.fast: topic /e.fast > 1]"
+    assert rename("e.faster or te.fast or topic /x.e.fast") == "e.faster or te.fast or topic /x.e.fast"
