@@ -68,6 +68,7 @@ class Engine:
         self.spec = spec
         self.store = Store(now, origin)
         self.orphans: List[Any] = []  # active behaviours of a replaced spec that this one lacks
+        self.history_lost: List[Tuple[int, str]] = []  # (behaviour, outside holder): adopt(carry=…)
         self.field_errors: Dict[Tuple[str, str], str] = {}
         # action -> [is active]; the holders: behaviour keys ('b:N') or outside holders (restored latches)
         self._active: Dict[str, List[bool]] = {a: [False] for a in spec.actions}
@@ -409,7 +410,8 @@ class Engine:
             flag[0] = bool(self._holders.get(action))
 
     # -- live reload ---------------------------------------------------------------------
-    def adopt(self, old: "Engine", now: float) -> List[Event]:
+    def adopt(self, old: "Engine", now: float,
+              carry: Optional[Callable[[CheckedBehaviour], str]] = None) -> List[Event]:
         """Take over the state of the engine this one replaces, then evaluate everything.
 
         Data (fields, arrivals, node samples) carries over for topics and nodes both specs
@@ -417,7 +419,10 @@ class Engine:
         its operators' state; a behaviour keeps its state when its name is unchanged (or, when
         unnamed, its condition and actions), so an active one does not start again; outside
         holders of actions (restored latches) stay. Topics new to this spec are watched from now.
-        Returns the events of the first evaluation. Call it on the engine's thread.
+        `carry`: for an active behaviour whose condition's `for`/`within`/`latch` history could
+        not be carried (operators added, removed or moved), the name of an outside holder that
+        keeps its actions on (listed in `history_lost`; the caller ends the hold). Returns the
+        events of the first evaluation. Call it on the engine's thread.
         """
         old.advance(now)
         src, dst = old.store, self.store
@@ -432,17 +437,22 @@ class Engine:
         dst.now = max(dst.now, now)
         old_rules = {n.key: n for n in old._nodes if not n.behaviour}
         old_sigs = {r.key: r.signature for r in old.spec.rules}
+        kept: Set[str] = set()  # rules whose operators' history was carried
         for node in self._nodes:
             if node.behaviour:
                 continue
             prev = old_rules.get(node.key)
             if prev is not None and old_sigs.get(node.key) == self.spec.rule(node.key).signature:
                 self._take_ops(prev, node)
+                kept.add(node.key)
                 if node.key in src.rules:
                     dst.rules[node.key] = src.rules[node.key]
             elif prev is not None and _same_ops(prev, node):  # edited: its `for`/`within`/`latch` keep
                 self._take_ops(prev, node)  # their history, so an edit that still holds releases nothing
+                kept.add(node.key)
         renames = self._take_renamed_rules(old, old_rules)
+        kept.update(renames.values())
+        self.history_lost = []
         old_behaviours = {n.behaviour.identity: n for n in old._nodes if n.behaviour}
         new_ones: List[_Node] = []
         for node in self._nodes:
@@ -452,12 +462,19 @@ class Engine:
             if prev is None:
                 new_ones.append(node)
             else:
-                if prev.behaviour.signature == node.behaviour.signature or _same_ops(prev, node):  # type: ignore[union-attr]
+                took = prev.behaviour.signature == node.behaviour.signature or _same_ops(prev, node)  # type: ignore[union-attr]
+                if took:
                     self._take_ops(prev, node)
                 node.active, node.value = prev.active, prev.value
                 if node.active:
                     for a in node.actions:
                         self._holders.setdefault(a, set()).add(node.key)
+                    b = node.behaviour
+                    if carry is not None and not b.latched and self._history_lost(node, took, kept):
+                        holder = carry(b)
+                        for a in node.actions:
+                            self._holders[a].add(holder)
+                        self.history_lost.append((b.index, holder))
         _take_condition_history(self, new_ones, list(old_behaviours.values()), renames)
         for action, holders in old._holders.items():
             outside = {h for h in holders if not h.startswith("b:")}
@@ -466,6 +483,24 @@ class Engine:
         self._sync_actions()
         self.orphans = [n for n in old_behaviours.values() if n.active]
         return self.evaluate_all(now)
+
+    def _history_lost(self, node: _Node, took: bool, kept: Set[str]) -> bool:
+        """Whether a behaviour's condition, or a rule it uses (at any depth), has `for`/`within`/
+        `latch` whose history a reload could not carry: it may read false only for want of it."""
+        if node.compiled.ops and not took:
+            return True
+        rules = {n.key: n for n in self._nodes if not n.behaviour}
+        todo = [e.key for e in ast.walk(node.behaviour.cond) if type(e) is ast.RuleRef]  # type: ignore[union-attr]
+        seen: Set[str] = set()
+        while todo:
+            key = todo.pop()
+            if key in seen or key not in rules:
+                continue
+            seen.add(key)
+            if rules[key].compiled.ops and key not in kept:
+                return True
+            todo.extend(self.spec.rule(key).rule_deps)
+        return False
 
     def _take_renamed_rules(self, old: "Engine", old_rules: Dict[str, _Node]) -> Dict[str, str]:
         """A rule new to this spec (a key the old one lacks: renamed, or its entity renamed) whose

@@ -49,7 +49,7 @@ class ClockJump:
         self.dispatcher = dispatcher
         self.log = log
         self.after = after  # called with the new engine (the latch state follows)
-        self.carried: List[Tuple[Any, Any, float]] = []  # (behaviour, identity, release at)
+        self.carried: List[Tuple[Any, Any, float, str]] = []  # (behaviour, identity, release at, holder)
         self.latched: List[Tuple[Any, Any]] = []  # (behaviour, identity): latched, held until ~reset
         self.jumps = 0
 
@@ -72,7 +72,7 @@ class ClockJump:
                 self.latched.append((b, keys[index]))
                 events += new.hold_actions(actions, _latched(b), now)
             else:
-                self.carried.append((b, keys[index], until))
+                self.carry(b, keys[index], until, _carried(b))
                 events += new.hold_actions(actions, _carried(b), now)  # active() stays true meanwhile
         self.log("warn", f"ROS time jumped back from {old.store.now:.3f} s to {now:.3f} s (a simulator reset?): "
                          f"every `for`, `age` and `frequency` window starts again from now"
@@ -81,6 +81,12 @@ class ClockJump:
         events += new.evaluate_all(now)
         self.after(new)
         return new, events
+
+    def carry(self, b: Any, key: Any, until: float, holder: str) -> None:
+        """Hold `b` (its actions held in the engine by `holder`) until `until`, or until the engine
+        starts it again under the same identity (take_over): a clock jump's, or a reload's whose
+        edit lost its condition's history (rubass/ros/reloading.py)."""
+        self.carried.append((b, key, until, holder))
 
     def take_over(self, engine: Engine, events: List[Event]) -> List[Event]:
         """Before dispatch: the start of a behaviour held across a jump (same identity) is no new
@@ -100,7 +106,7 @@ class ClockJump:
             more: List[Event] = []
             for c in carried:
                 self.carried.remove(c)
-                more += engine.release_holder(_carried(c[0]), e.time)
+                more += engine.release_holder(c[3], e.time)
             for b, _ in latched:
                 self.latched.remove((b, key))
                 if (b, key) in self.dispatcher.orphans:
@@ -121,16 +127,16 @@ class ClockJump:
             return
         active = set(engine.active_behaviours())
         keep = []
-        for b, key, until in self.carried:
+        for b, key, until, holder in self.carried:
             if b.index in active and engine.spec.behaviours[b.index - 1] is b:
-                self.dispatcher.handle(engine, engine.release_holder(_carried(b), now), "clock jump")
+                self.dispatcher.handle(engine, engine.release_holder(holder, now), "clock jump")
                 continue  # the engine holds it again, under the same identity
             if now >= until or now < until - 3600.0:
                 self.dispatcher.release(b, key, now)
                 self.dispatcher.report_event(Event(now, "release", b.index), b, (), "deadline")  # pairs its start
-                self.dispatcher.handle(engine, engine.release_holder(_carried(b), now), "clock jump")
+                self.dispatcher.handle(engine, engine.release_holder(holder, now), "clock jump")
             else:
-                keep.append((b, key, until))
+                keep.append((b, key, until, holder))
         self.carried = keep
 
 

@@ -17,6 +17,7 @@ from ..lang import SpecError, load_spec
 from ..lang.errors import RubassError, counted
 from ..lang.libtopics import running_type_changes
 from ..lang.model import CheckedSpec
+from .clockjump import horizon
 from .gcfreeze import freeze_heap
 from .libtypes import render_failed_check
 from .topics import ros_now
@@ -192,11 +193,34 @@ class Reloading:
             time.sleep(0.1)
         return load_spec(self.config.spec, self.config.actions)
 
+    def _hold_lost_history(self, new: Engine, events: List[Event], now: float) -> List[Event]:
+        """An active behaviour whose edit restarted its condition's `for`/`within` (operators added or
+        moved) may read false only for want of that history: it is not released at the reload but held
+        until its condition could hold again (the spec's longest window, plus 0.5 s, as across a clock
+        jump); if it starts again by then it goes on with no second start (ClockJump.take_over)."""
+        if not new.history_lost:
+            return events
+        held = dict(new.history_lost)
+        until = now + horizon(new.spec)
+        keys = self.dispatcher.keys_of(new.spec)
+        out: List[Event] = []
+        for e in events:
+            if e.kind == "release" and e.behaviour in held:
+                b = new.spec.behaviours[e.behaviour - 1]
+                self.clock_jump.carry(b, keys[b.index], until, held.pop(e.behaviour))
+                rospy.logwarn("rubass: %s: the reload restarted its condition's `for`/`within`; held until it could "
+                              "hold again (%.1f s), then released unless it does", b.label, until - now)
+                continue
+            out.append(e)
+        for holder in held.values():  # still active by itself: nothing to hold over
+            out += new.release_holder(holder, now)
+        return out
+
     def _swap(self, old: Engine, new: Engine, spec: CheckedSpec, runners: Dict[str, ActionRunner]) -> None:
         """On the engine's thread: nothing is evaluated between the old rules and the new."""
         now = ros_now()
         self._on_events(old.advance(now), "deadline")  # what fell due up to the swap, under the old rules
-        events = new.adopt(old, now)
+        events = self._hold_lost_history(new, new.adopt(old, now, carry=_held_over), now)
         old_keys = self.dispatcher.keys_of(old.spec)
         old_runners = self.dispatcher.runners
         leaving = {old_keys[o.checked.index] for o in new.orphans if not o.checked.latched}
@@ -218,6 +242,10 @@ class Reloading:
                 self.dispatcher.release(b, old_keys[b.index], now, gone)
                 self.dispatcher.report_event(Event(now, "release", b.index), b, (), "reload")  # pairs its start
         self.keeper.save(new, self.dispatcher.orphans, self._fail_safes())
+
+
+def _held_over(b: Any) -> str:
+    return f"{b.label} (held over a reload that restarted its condition's `for`/`within`)"
 
 
 def _stamps(paths: List[str]) -> List[Tuple[int, int]]:

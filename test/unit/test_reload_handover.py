@@ -45,12 +45,16 @@ class Monitor(reloading.Reloading):
     """The real swap, dispatcher and runners (their threads not started: their queues are read)."""
 
     def __init__(self, engine, runners):
+        from rubass.ros.clockjump import ClockJump
+
         self.loop = type("Loop", (), {"engine": engine})()
         self.dispatcher = Dispatcher(runners, lambda record: self.records.append(record), lambda: 0.0)
         self.keeper = type("K", (), {"save": lambda *a: None})()
+        self.clock_jump = ClockJump(self.dispatcher, lambda level, text: None, lambda engine: None)
         self.records = []
 
     def _on_events(self, events, cause):
+        events = self.clock_jump.take_over(self.loop.engine, events)  # as Monitor._on_events
         self.dispatcher.handle(self.loop.engine, events, cause)
 
     def _fail_safes(self):
@@ -232,3 +236,58 @@ def test_a_renamed_key_is_replaced_only_as_a_whole_name():
     rename = _renamer({"e.fast": "base.fast"})
     assert rename("e.fast for 0.5 [e.fast: topic /e.fast > 1]") == "base.fast for 0.5 [base.fast: topic /e.fast > 1]"
     assert rename("e.faster or te.fast or topic /x.e.fast") == "e.faster or te.fast or topic /x.e.fast"
+
+
+EDITS = {  # the rule given a minimum hold (operators added); the `for` moved into the behaviour
+    "within": ("entity e { rules: high: ((topic /v.data > 1) for 1 s) within 2 s; }\n", "halt: if (e.high)"),
+    "moved": ("entity e { rules: high: topic /v.data > 1; }\n", "halt: if (e.high for 1 s)"),
+}
+
+
+def _held_stop(monkeypatch, edit, later):
+    """A stop on `high: (v > 1) for 1 s` since 2.0 s, reloaded at 3.0 s with `edit`; `later`: the
+    values of /v after the reload. The board's phases, and the last record's event and cause."""
+    head = "action primitive board_stop, warn;\n"
+    text = head + "entity e { rules: high: (topic /v.data > 1) for 1 s; }\nhalt: if (e.high) then { board_stop; }\n"
+    board = ActionRunner(Board("board_stop"), print)
+    engine = Engine(check_text(text, os.path.join(ROOT, "s.rbs"), [LIB]), 0.0)
+    engine.evaluate_all(0.0)
+    monitor = Monitor(engine, {"board_stop": board})
+    monitor._on_events(engine.on_message("/v", 1.0, {"data": 2.0}), "message")
+    run_to(engine, monitor, 2.5)
+    assert phases(board) == ["start"]
+    monkeypatch.setattr(reloading, "ros_now", lambda: 3.0)
+    rule, cond = EDITS[edit]
+    new = Engine(check_text(head + rule + cond + " then { board_stop; }\n", os.path.join(ROOT, "s.rbs"), [LIB]), 3.0)
+    monitor._swap(engine, new, new.spec, {"board_stop": board})
+    assert phases(board) == ["start"], "released at the reload, with the speed still over the limit"
+    for t, v in later:
+        run_to(new, monitor, t)
+        monitor.clock_jump.check(new, t)  # the monitor's tick
+        monitor._on_events(new.on_message("/v", t, {"data": v}), "message")
+    for t in (4.49, 4.5, 5.0, 5.49, 5.5, 6.0):
+        run_to(new, monitor, t)
+        monitor.clock_jump.check(new, t)
+    return board, new, monitor
+
+
+@pytest.mark.parametrize("edit", sorted(EDITS))
+def test_an_edit_that_restarts_a_held_conditions_for_does_not_release_its_stop(monkeypatch, edit):
+    """The re-sweep of reloads: adding a minimum hold to a held rule (`… within 2 s`), or moving its
+    `for` into the behaviour, made it read false until its new `for` elapsed: the stop was released at
+    the reload and a creep took the base for a second. It is held until its condition could hold again,
+    and the engine owns it again, with no second start, when it does."""
+    board, new, monitor = _held_stop(monkeypatch, edit, [(3.5, 2.0), (4.2, 2.0)])
+    assert [p for p in phases(board) if p != "hold"] == ["start"] and board.active  # the start became a hold
+    assert new.active_behaviours() == [1] and not monitor.clock_jump.carried
+    assert [r["event"] for r in monitor.records] == ["start"], "no second start, no release in ~events"
+
+
+@pytest.mark.parametrize("edit", sorted(EDITS))
+def test_a_stop_held_over_a_reload_is_released_when_its_condition_could_have_held_again(monkeypatch, edit):
+    board, new, monitor = _held_stop(monkeypatch, edit, [(3.2, 0.0)])
+    assert phases(board) == ["start", "release"] and not board.active
+    assert new.active_behaviours() == [] and not new.active_actions()
+    assert [(r["event"], r["cause"]) for r in monitor.records][-1] == ("release", "deadline")
+    longest = {"within": 2.0, "moved": 1.0}[edit]
+    assert monitor.records[-1]["time"] == pytest.approx(3.0 + longest + 0.5)  # the spec's longest window + 0.5 s
