@@ -230,6 +230,10 @@ class Reloading:
                 runner.adopt(prev, leaving)
         self.dispatcher.runners = runners
         self.loop.engine = new  # type: ignore[union-attr]
+        for orphan in new.orphans:  # in ~events before the new rules' starts: one that reads as the old (a
+            b = orphan.checked  # renamed entity's unnamed behaviour, the same number) pairs as still on
+            if not b.latched:
+                self.dispatcher.report_event(Event(now, "release", b.index), b, (), "reload")  # pairs its start
         self._on_events(events, "reload")  # the latch state is written before a latched start is dispatched
         # Then what the new rules no longer hold: after their starts, so that an action a new (renamed,
         # edited) behaviour holds too is never released in between (its board would read "R" then "S").
@@ -240,7 +244,6 @@ class Reloading:
                 self.dispatcher.orphans.append((b, old_keys[b.index]))
             else:
                 self.dispatcher.release(b, old_keys[b.index], now, gone)
-                self.dispatcher.report_event(Event(now, "release", b.index), b, (), "reload")  # pairs its start
         self.keeper.save(new, self.dispatcher.orphans, self._fail_safes())
 
 

@@ -96,7 +96,8 @@ def test_an_edit_that_makes_an_active_stop_another_behaviour_never_releases_the_
     assert phases(board) == ["start"], "the board read R then S at the reload, with the speed still over"
     assert board.active
     kinds = [(r["event"], r.get("name", "")) for r in monitor.records]
-    assert kinds[-2:] == [("start", new.spec.behaviours[0].name), ("release", "")]  # the new holds it first
+    # ~events: the old one's release before the new one's start, so pairing by number ends "on"
+    assert kinds[-2:] == [("release", ""), ("start", new.spec.behaviours[0].name)]
     monitor._on_events(new.on_message("/v", 3.0, {"data": 0.0}), "message")
     assert phases(board) == ["start", "release"] and not board.active
 
