@@ -13,6 +13,10 @@ from ..lang.library import ActionDef
 from ..lang.stdlib import is_standard_library
 
 
+# Python keeps a module it imported: a reload (SIGHUP, ~reload) reads the library again, not the code
+_CODE_CACHED = " (its module is loaded already: after changing the plugin's code, restart the monitor)"
+
+
 class ActionSetupError(Exception):
     """An action that cannot work as configured (unknown type, bad message fields, …)."""
 
@@ -127,16 +131,16 @@ class CustomPlugin(ActionPlugin):
                               f"{exc.__class__.__name__}: {exc}") from None
         cls = getattr(module, class_name, None)
         if cls is None:
-            raise self._error(f"module '{module_name}' has no class '{class_name}'")
+            raise self._error(f"module '{module_name}' has no class '{class_name}'{_CODE_CACHED}")
         missing = [m for m in ("start", "hold", "release") if not callable(getattr(cls, m, None))]
         if not inspect.isclass(cls) or missing:  # checked before anything of it is called
             raise self._error(f"{action.plugin} is not a plugin class: it needs start(ctx), hold(ctx) and "
-                              f"release(ctx) methods")
+                              f"release(ctx) methods{_CODE_CACHED}")
         try:
             self.impl = cls(action.name, dict(action.params))
         except Exception as exc:
             raise self._error(f"{action.plugin}({action.name!r}, params) failed: "
-                              f"{exc.__class__.__name__}: {exc}") from None
+                              f"{exc.__class__.__name__}: {exc}{_CODE_CACHED}") from None
         self.per_behaviour = bool(getattr(self.impl, "per_behaviour", False))
         self.period = getattr(self.impl, "period", None)
         self.call_timeout = float(getattr(self.impl, "call_timeout", 0.0) or 0.0)  # how long a call may block

@@ -18,6 +18,9 @@ Report = Callable[[Dict[str, Any]], None]
 RESTORED = "rubass-restored"  # the runners' identity for a restored latch: (RESTORED, holder)
 
 
+RETRY = 1.0  # s between tries to write a latch state that could not be written
+
+
 def behaviour_holder(b: Any) -> str:
     return f"behaviour {b.index} (line {b.span.line})"
 
@@ -30,6 +33,7 @@ class LatchKeeper:
         self.restored: List[Latch] = []
         self.problems: List[str] = []  # what was wrong with the file at start
         self.elsewhere: List[str] = []  # files of this node for other masters holding latches, until ~reset
+        self._retried = float("-inf")  # when a failed write was last tried again (retry)
 
     # -- start ---------------------------------------------------------------------------
     def restore(self, actions: Dict[str, Any], runners: Dict[str, Any], now: float) -> None:
@@ -66,6 +70,19 @@ class LatchKeeper:
 
     def save(self, engine: Engine, orphans: Sequence[Any], fail_safes: Sequence[Sequence[str]]) -> None:
         """Write the state now: call it before a latched action is dispatched."""
+        if not self.file.save(self._latches(engine, orphans, fail_safes)):
+            self.log("error", f"{self.file.error}: a latched stop would not survive the monitor's restart")
+
+    def retry(self, engine: Engine, orphans: Sequence[Any], fail_safes: Sequence[Sequence[str]], now: float) -> None:
+        """At a tick, while the last write failed (a full disk): write again at most every RETRY seconds,
+        so that once the disk is freed a latched stop is in the file before a restart needs it."""
+        if not self.file.error or 0.0 <= now - self._retried < RETRY:  # (time that went back: now)
+            return
+        self._retried, was = now, self.file.error
+        if self.file.save(self._latches(engine, orphans, fail_safes)):
+            self.log("info", f"latch state written again (it could not be: {was})")
+
+    def _latches(self, engine: Engine, orphans: Sequence[Any], fail_safes: Sequence[Sequence[str]]) -> List[Latch]:
         spec = engine.spec
         items = []
         for index in engine.active_behaviours():
@@ -76,8 +93,7 @@ class LatchKeeper:
         for i, names in enumerate(fail_safes):
             items.append((f"fail-safe {i}", [a for a in names if a in spec.actions and spec.actions[a].latch]))
         items += [(r.holder, r.actions) for r in self.restored]
-        if not self.file.save(holders(items)):
-            self.log("error", f"{self.file.error}: a latched stop would not survive the monitor's restart")
+        return holders(items)
 
     def reset(self, runners: Dict[str, Any], now: float) -> int:
         """~reset: release the restored latches; how many there were."""

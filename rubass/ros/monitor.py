@@ -320,6 +320,8 @@ class Monitor(Reloading):
         if was and not self.overload.active:
             self.keeper.save(loop.engine, self.dispatcher.orphans, self._fail_safes())
         self.clock_jump.check(loop.engine, now)
+        if self.keeper.file.error:  # a latch state that could not be written (a full disk): tried again
+            self.keeper.retry(loop.engine, self.dispatcher.orphans, self._fail_safes(), now)
         if self.error_guard.actions:
             errors = self._data_errors(loop.engine)
             was = self.error_guard.active

@@ -70,3 +70,34 @@ def test_a_latch_file_under_the_former_default_name_is_adopted_once(tmp_path):
         fh.write("{}")
     assert not adopt_old_default(new, old), "a file under the new name is never replaced"
     assert adopt_old_default(str(tmp_path / "x.json"), str(tmp_path / "none.json")) is False
+
+
+def test_a_latch_state_that_could_not_be_written_is_written_once_the_disk_is_free(tmp_path):
+    """An acceptance sweep: a latched stop that started while the disk was full was never written
+    after the disk was freed (writes happened only on changes), so a kill -9 later restarted without
+    it: the robot went again without ~reset. The keeper tries again at the ticks, once a second."""
+    from rubass.actions.keeper import RETRY, LatchKeeper
+    from rubass.engine import Engine
+    from rubass.lang import check_text
+
+    from conftest import ROOT
+    spec = check_text("action primitive stop;\nentity e { rules: r: topic /v.data > 1; }\nif (e.r) then { stop; }\n",
+                      str(tmp_path / "s.rbs"), [os.path.join(ROOT, "docs", "examples", "actions.yaml")])
+    engine = Engine(spec, 0.0)
+    engine.evaluate_all(0.0)
+    full = tmp_path / "full"
+    full.write_text("a file where the folder should be: every write fails")
+    logs = []
+    keeper = LatchKeeper(LatchFile(str(full / "latch.json")), lambda level, text: logs.append((level, text)),
+                         lambda record: None)
+    engine.on_message("/v", 1.0, {"data": 2.0})  # the latched stop starts
+    keeper.save(engine, [], [])
+    assert keeper.file.error and logs[-1][0] == "error"
+    keeper.retry(engine, [], [], 1.5)
+    assert keeper.file.error  # still full
+    full.unlink()  # the disk is freed
+    keeper.retry(engine, [], [], 1.5 + RETRY / 2)
+    assert keeper.file.error, "at most once a second"
+    keeper.retry(engine, [], [], 1.5 + RETRY)
+    assert not keeper.file.error and logs[-1][0] == "info"
+    assert load(str(full / "latch.json"), {"stop": True})[0] == [Latch("behaviour 1 (line 3)", ("stop",))]
