@@ -246,7 +246,10 @@ class LatchFile:
                     fh.write(body)
                 os.replace(tmp, self.path)  # survives the process's death from here on
             except OSError as exc:
-                self.error = f"cannot write the latch state {self.path}: {exc.strerror or exc}"
+                folder = os.path.dirname(self.path) or "."
+                why = f"{folder} is not a folder" if os.path.exists(folder) and not os.path.isdir(folder) \
+                    else (exc.strerror or str(exc))  # makedirs says "File exists" for a file in the way
+                self.error = f"cannot write the latch state {self.path}: {why}"
                 return False
             self._last, self.error = state, ""
         if state:  # on disk too before a power cut, without holding the engine's thread for it
