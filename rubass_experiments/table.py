@@ -42,6 +42,11 @@ def print_table(data: Dict[str, Any], out: TextIO) -> bool:
                   f"{stopped}{'' if r['stopped'] == r['runs'] else '  NOT EVERY TIME'}"
                   f"{'  (interrupted)' if r.get('interrupted') else ''}\n")
     notes = [f"{r['row']}: {r['note']}" for r in data["rows"] if r["note"]]
+    early = [(r["row"], d["b"]) for r in data["rows"] for d in r.get("details", ()) if (d.get("b") or 0.0) < 0.0]
+    if early:  # the due instant comes from the recorder's receive times, which lag on a loaded machine
+        notes.append(f"(b) below 0 in {len(early)} run(s) ({', '.join(f'{row} {b * 1000:.1f} ms' for row, b in early)}): "
+                     f"the recorder received the data after the base got the stop, so its receive times (the due "
+                     f"instant) lagged by more than the monitor's own delay; (b) there is a lower bound, not a delay")
     errors = [f"{r['row']}: {e}" for r in data["rows"] for e in r["errors"]]
     if notes:
         out.write("\nnotes: " + "; ".join(notes) + "\n")

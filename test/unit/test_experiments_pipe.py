@@ -43,17 +43,15 @@ def test_an_interrupted_experiment_removes_an_earlier_runs_plot(tmp_path, monkey
     assert "(not drawn: interrupted)" in capsys.readouterr().out
 
 
-def test_a_stop_before_its_due_instant_is_no_negative_delay(monkeypatch):
-    """An acceptance sweep: on a loaded machine the demo printed (b) = -10.3 ms: the recorder, whose
-    receive times give the due instant, got the data after the base got the stop."""
-    row = ROWS[0]
-    result = runner.RunResult(row.name, 0, False, events=[{"event": row.until, "wall": 100.000},
-                                                           {"event": row.origin, "wall": 99.000}])
-    monkeypatch.setattr(runner, "_due_from_bag", lambda *a, **k: 100.0103)
-    runner._measure(row, result, "spec.rbs", 99.0)
-    assert result.stopped and result.a == 1.0
-    assert result.b is None and "recorder received the data 10.3 ms after the stop" in result.error
-    monkeypatch.setattr(runner, "_due_from_bag", lambda *a, **k: 99.998)
-    result = runner.RunResult(row.name, 0, False, events=result.events)
-    runner._measure(row, result, "spec.rbs", 99.0)
-    assert result.b == 100.000 - 99.998 and not result.error
+def test_a_negative_delay_is_said_to_be_the_recorders_lag(capsys):
+    """An acceptance sweep: on a loaded machine the demo printed (b) = -10.3 ms with nothing to say why:
+    the due instant comes from the recorder's receive times, which lagged behind the base's."""
+    from rubass_experiments.table import print_table
+
+    row = {"row": "Spin (0.2 s)", "ideal": 0.2, "note": "", "paper": None, "a": None, "runs": 2, "stopped": 2,
+           "b": {"avg": 0.0, "sd": 0.0, "min": -0.0103, "max": 0.0029, "p99": 0.0029, "n": 2}, "errors": [],
+           "details": [{"b": -0.0103}, {"b": 0.0029}]}
+    out = io.StringIO()
+    assert print_table({"rows": [row]}, out)  # still a run that stopped: the figure is a bound, not a failure
+    assert "(b) below 0 in 1 run(s) (Spin (0.2 s) -10.3 ms): the recorder received the data after the base" \
+        in out.getvalue()
