@@ -13,7 +13,7 @@ import rospy
 from geometry_msgs.msg import Twist
 
 from .faults import Drift
-from .common import on_fault
+from .common import freeze_heap, on_fault
 from .eventlog import EventLog
 
 
@@ -39,6 +39,7 @@ def main() -> None:
 
     on_fault(fault)
     rospy.Subscriber("/cmd_vel", Twist, relay, tcp_nodelay=True)
+    freeze_heap()
     rospy.spin()
 
 

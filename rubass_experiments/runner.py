@@ -35,6 +35,7 @@ PY = "/usr/bin/python3"
 CONFIG = os.path.join(ROOT, "config")
 WARMUP = 1.5        # seconds of normal driving before the fault
 STOP_TIMEOUT = 25.0  # seconds after the fault to wait for the stop
+MONITOR_NICE = -10   # the monitor's ~nice, as docs/monitor.md advises on a busy robot computer
 
 
 @dataclass
@@ -44,6 +45,8 @@ class RunResult:
     stopped: bool
     a: Optional[float] = None        # seconds, the paper's definition
     b: Optional[float] = None        # seconds, the monitor's own delay
+    b_monitor: Optional[float] = None  # of (b): due instant -> the monitor dispatching the stop (its ~events start)
+    nice_refused: bool = False       # the monitor could not take MONITOR_NICE (not root): it ran as started
     due_source: str = ""
     error: str = ""
     bag: str = ""
@@ -161,7 +164,7 @@ def run_once(session: Session, row: Row, rep: int) -> RunResult:
         if row.robot == "frobit":
             _wait(lambda: os.path.lexists(os.path.join(run_dir, "board")), 15, "the safety board's port")
         monitor = spawn("monitor", [PY, os.path.join(ROOT, "scripts", "monitor"), "__name:=rubass",
-                                    f"_spec:={spec_path}", "_node_rate:=10",
+                                    f"_spec:={spec_path}", "_node_rate:=10", f"_nice:={MONITOR_NICE}",
                                     # each run starts unlatched: its own latch state file (issue 13)
                                     f"_state_file:={os.path.join(run_dir, 'latches.json')}"])
         wait_for_service("/rubass/reset", monitor, session.master.uri, 30)
@@ -181,6 +184,8 @@ def run_once(session: Session, row: Row, rep: int) -> RunResult:
         _wait(lambda: os.path.exists(bag), 1, "the bag")
         result.events = read_events(events_file)
         _measure(row, result, spec_path, fault_sent)
+        with open(os.path.join(run_dir, "monitor.log"), errors="replace") as fh:
+            result.nice_refused = f"~nice {MONITOR_NICE}: " in fh.read()
     except Interrupted as exc:
         result.interrupted, result.error = True, f"interrupted by {exc.name}"
     except Exception as exc:  # a run that breaks is reported, and the others go on
@@ -225,6 +230,9 @@ def _measure(row: Row, result: RunResult, spec_path: str, fault_sent: float) -> 
         result.error = "the replay of the bag found no behaviour start"
         return
     result.b = stop - due  # negative when the recorder got the data after the base got the stop (table.py says so)
+    dispatched = _dispatch_from_bag(result.bag, fault_sent, row.behaviour)
+    if dispatched is not None:  # the rest of (b) is the stop's way to the base: a hop, the base's own pauses
+        result.b_monitor = dispatched - due
 
 
 def _due_from_bag(spec_path: str, bag_path: str, after: float, behaviour: str = "") -> Optional[float]:
@@ -244,6 +252,27 @@ def _due_from_bag(spec_path: str, bag_path: str, after: float, behaviour: str = 
     starts = [info.start + e.time for e in events if e.kind == "start" and info.start + e.time >= after - 0.5
               and wanted in (None, e.behaviour)]
     return min(starts) if starts else None
+
+
+def _dispatch_from_bag(bag_path: str, after: float, behaviour: str = "") -> Optional[float]:
+    """When the monitor dispatched the first start after `after` (of that behaviour, if named), as
+    its ~events record says: the instant it became due by its own clock plus its latency."""
+    try:
+        bag, info = open_bag(bag_path)
+    except BagError:
+        return None
+    with bag:
+        if "/rubass/events" not in info.types:
+            return None
+        for _, _, msg in read(bag, ["/rubass/events"], {"/rubass/events"}):
+            try:
+                record = json.loads(msg.data)
+            except (AttributeError, ValueError):
+                continue
+            if (record.get("event") == "start" and record.get("time", 0.0) >= after - 0.5
+                    and record.get("latency_ms") is not None and (not behaviour or record.get("name") == behaviour)):
+                return record["time"] + record["latency_ms"] / 1000.0
+    return None
 
 
 def results_json(rows: List[Row], results: List[RunResult]) -> Dict[str, Any]:
@@ -282,6 +311,8 @@ def main_loop(rows: List[Row], reps: int, out: str, sup: Supervisor, progress: A
                 outcome.results.append(res)
                 a = f"{res.a:.3f} s" if res.a is not None else "-"
                 b = f"{res.b * 1000:.1f} ms" if res.b is not None else "-"
+                if res.b is not None and res.b_monitor is not None:
+                    b += f" ({res.b_monitor * 1000:.1f} in the monitor, {(res.b - res.b_monitor) * 1000:.1f} to the base)"
                 progress.write(f"  {r.name:<13} run {rep + 1}/{reps}: stopped={res.stopped} (a) {a} (b) {b}"
                                f"{'  ' + res.error if res.error else ''}\n")
                 progress.flush()

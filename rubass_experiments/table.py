@@ -47,6 +47,17 @@ def print_table(data: Dict[str, Any], out: TextIO) -> bool:
         notes.append(f"(b) below 0 in {len(early)} run(s) ({', '.join(f'{row} {b * 1000:.1f} ms' for row, b in early)}): "
                      f"the recorder received the data after the base got the stop, so its receive times (the due "
                      f"instant) lagged by more than the monitor's own delay; (b) there is a lower bound, not a delay")
+    refused = sum(d.get("nice_refused", False) for r in data["rows"] for d in r.get("details", ()))
+    if refused:  # the runner starts it at ~nice -10, which needs root or CAP_SYS_NICE
+        notes.append(f"the monitor ran at its starting priority in {refused} run(s), not at nice -10 "
+                     f"(not permitted: see a run's monitor.log)")
+    slow = [(r["row"], d) for r in data["rows"] if r["row"] != "CPU" for d in r.get("details", ())
+            if (d.get("b") or 0.0) * 1000 > TARGET_B_P99_MS]
+    if slow:  # where the time went: the monitor's dispatch (its ~events start) or the way to the base
+        notes.append(f"(b) over {TARGET_B_P99_MS:g} ms in {len(slow)} run(s): " + ", ".join(
+            f"{row} run {d['rep'] + 1} {d['b'] * 1000:.1f} ms"
+            + (f" ({d['b_monitor'] * 1000:.1f} in the monitor, {(d['b'] - d['b_monitor']) * 1000:.1f} to the base)"
+               if d.get("b_monitor") is not None else "") for row, d in slow))
     errors = [f"{r['row']}: {e}" for r in data["rows"] for e in r["errors"]]
     if notes:
         out.write("\nnotes: " + "; ".join(notes) + "\n")

@@ -18,6 +18,7 @@ Parameters (private)
                                   $ROS_HOME/rubass/NODE.latches.json for a master on this machine
                                   at port 11311, else NODE.PORT.latches.json, or NODE.HOST.PORT.
                                   latches.json for another machine's master; false: off)
+    ~nice (int, -20 to 19)        the threads' scheduling priority, set at start (priority.py)
 Subscribes
     every topic the spec names, whatever its type (rospy.AnyMsg, tcp_nodelay)
     /rubass/agent_samples (std_msgs/String)  the agents' reports: cpu and memory of nodes on

@@ -14,6 +14,7 @@ from ..actions.latches import adopt_old_default, adopt_unkeyed, default_path, ma
 from .latch_master import is_local
 from .monitor import ConfigError, Monitor
 from .params import HELP, ParamError, read_config, unknown_params
+from .priority import set_nice
 from .rosout_param import keep_rosout_flag
 from .startup import init_node, wants_help
 
@@ -55,6 +56,12 @@ def main(argv: Optional[List[str]] = None) -> int:
                           "this master's", unkeyed, state_file)
     try:
         config = read_config(lambda name, default: rospy.get_param("~" + name, default), state_file)
+        if config.nice is not None:  # before the monitor's threads start: they inherit it
+            refused = set_nice(config.nice)
+            if refused:
+                rospy.logwarn("rubass: %s", refused)
+            else:
+                rospy.loginfo("rubass: running at nice %d (~nice)", config.nice)
         monitor = Monitor(config)
         monitor.setup()
     except (ParamError, ConfigError) as exc:

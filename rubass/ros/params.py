@@ -29,10 +29,11 @@ class MonitorConfig:
     queue_size: int = 100000  # messages the engine's queue holds
     state_file: Optional[str] = None  # latched actions kept across restarts; None: off
     error_actions: List[str] = field(default_factory=list)  # run while a field cannot be read
+    nice: Optional[int] = None  # the threads' nice value (-20 to 19); None: as started (priority.py)
 
 
 KNOWN = ("spec", "actions", "rate", "node_rate", "diagnostics_rate", "master_rate", "overload_actions",
-         "queue_size", "error_actions", "state_file")
+         "queue_size", "error_actions", "state_file", "nice")
 
 # `rosrun rubass monitor --help`: each parameter with its type, default and range (read_config checks them)
 HELP = """  ~spec (string, required)          the RuBaSS spec to enforce
@@ -46,6 +47,8 @@ HELP = """  ~spec (string, required)          the RuBaSS spec to enforce
   ~error_actions (list, [])         actions to run while a field cannot be read
   ~state_file (path or false, under $ROS_HOME/rubass/)  latched actions kept across the
                                     monitor's restarts; false: none kept (WARN in /diagnostics)
+  ~nice (int, -20 to 19, as started)  the monitor's scheduling priority, e.g. -10 on a busy
+                                    computer (below the current value: root or CAP_SYS_NICE)
 Private parameters stay on the master after the monitor stops: a later rosrun reads them again
 (rosparam get /rubass; rosparam delete /rubass/NAME).
 """
@@ -110,6 +113,9 @@ def read_config(get: Getter, default_state_file: Optional[str] = None) -> Monito
     queue_size = get("queue_size", 100000)
     if not isinstance(queue_size, int) or isinstance(queue_size, bool) or not 10 <= queue_size <= 10_000_000:
         raise ParamError(f"~queue_size must be a whole number of messages from 10 to 10000000, got {queue_size!r}")
+    nice = get("nice", None)
+    if nice is not None and (not isinstance(nice, int) or isinstance(nice, bool) or not -20 <= nice <= 19):
+        raise ParamError(f"~nice must be a whole number from -20 (highest priority) to 19, got {nice!r}")
     return MonitorConfig(
         spec=os.path.expanduser(spec),
         actions=[os.path.expanduser(a) for a in actions],
@@ -121,6 +127,7 @@ def read_config(get: Getter, default_state_file: Optional[str] = None) -> Monito
         queue_size=queue_size,
         state_file=_state_file(get, default_state_file),
         error_actions=error_actions,
+        nice=nice,
     )
 
 

@@ -55,3 +55,19 @@ def test_a_negative_delay_is_said_to_be_the_recorders_lag(capsys):
     assert print_table({"rows": [row]}, out)  # still a run that stopped: the figure is a bound, not a failure
     assert "(b) below 0 in 1 run(s) (Spin (0.2 s) -10.3 ms): the recorder received the data after the base" \
         in out.getvalue()
+
+
+def test_a_run_over_the_target_is_named_with_where_its_time_went(capsys):
+    """CI failed once on Spin (0.2 s) at (b) 12.6 ms with nothing to say whether the monitor or the way
+    to the base took it; the table now says which, and when the monitor could not take its ~nice."""
+    from rubass_experiments.table import print_table
+
+    row = {"row": "Spin (0.2 s)", "ideal": 0.2, "note": "", "paper": None, "a": None, "runs": 2, "stopped": 2,
+           "b": {"avg": 0.007, "sd": 0.0, "min": 0.0017, "max": 0.0126, "p99": 0.0126, "n": 2}, "errors": [],
+           "details": [{"rep": 0, "b": 0.0126, "b_monitor": 0.0012, "nice_refused": True},
+                       {"rep": 1, "b": 0.0017, "b_monitor": 0.0011, "nice_refused": False}]}
+    out = io.StringIO()
+    assert not print_table({"rows": [row]}, out)
+    text = out.getvalue()
+    assert "(b) over 10 ms in 1 run(s): Spin (0.2 s) run 1 12.6 ms (1.2 in the monitor, 11.4 to the base)" in text
+    assert "the monitor ran at its starting priority in 1 run(s), not at nice -10" in text

@@ -22,9 +22,9 @@ def test_help_names_every_parameter_and_the_queue_size_range():
 
 
 @pytest.mark.parametrize("name,lo,hi", [(m.group(1), float(m.group(2)), float(m.group(3)))
-                                        for m in re.finditer(r"~(\w+) \((?:Hz|int), ([\d.]+) to ([\d.]+),", HELP)])
+                                        for m in re.finditer(r"~(\w+) \((?:Hz|int), (-?[\d.]+) to ([\d.]+),", HELP)])
 def test_each_stated_range_is_the_enforced_one(name, lo, hi):
-    whole = name == "queue_size"
+    whole = name in ("queue_size", "nice")
     kind = int if whole else float
     assert getattr(config(**{name: kind(lo)}), name) == kind(lo)
     assert getattr(config(**{name: kind(hi)}), name) == kind(hi)
