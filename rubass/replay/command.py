@@ -2,7 +2,6 @@
 from __future__ import annotations
 
 import argparse
-import dataclasses
 import gc
 import json
 import os
@@ -65,21 +64,21 @@ def bag_type_errors(spec: Any, spec_path: str, actions: Sequence[str], bag: Any,
 
 def bag_check(spec: Any, spec_path: str, actions: Sequence[str], bag: Any, bag_path: str, info: Any,
               decode: Set[str], prog: str) -> Tuple[List[str], List[str]]:
-    """(errors, warnings) of SPEC against the recording (bag_type_errors); the warnings are the spec's, as
-    `rubass check --bag` prints them (in the order of the text), e.g. a stamp_age() that is always unknown."""
+    """(errors, warnings) of SPEC against the recording (bag_type_errors): the spec's errors as `rubass check
+    --bag` gives them (load_spec_against), then fields its classes lack; the warnings are the spec's, as
+    it prints them (in the order of the text), e.g. a stamp_age() that is always unknown."""
     from ..lang.errors import in_text_order
     from ..ros.bag import BagError, message_classes
-    from ..ros.model_sources import bag_model
+    from ..ros.model_sources import bag_model, load_spec_against
     from ..ros.msgtypes import check_path
 
     try:
         classes = message_classes(bag, sorted(decode))
     except BagError as exc:
         return [f"{prog}: error: {exc}"], []
-    try:  # the recording's types as a system model
-        model = bag_model(bag_path)
-        checked = load_spec(spec_path, list(actions), model=model)
-    except SpecError as exc:
+    try:  # the recording's types as a system model, and every other type recorded on one of its topics
+        checked = load_spec_against(spec_path, list(actions), bag_model(bag_path), bag_path)
+    except SpecError as exc:  # each error against another type names it (as `rubass check --bag` says it)
         return [exc.render()], []
     except BagError as exc:
         return [f"{prog}: error: {exc}"], []
@@ -87,14 +86,6 @@ def bag_check(spec: Any, spec_path: str, actions: Sequence[str], bag: Any, bag_p
     errors: List[str] = []
     types = {t: [(getattr(c, '_type', info.types[t]), c)] for t, c in classes.items()}  # topic -> (type, class)…
     for topic, type_name, conn in _other_types(bag, info, decode):
-        variant = dataclasses.replace(model, topics={**model.topics, topic: type_name})
-        try:  # the spec against the topic's other type, errors at their place as for the first
-            load_spec(spec_path, list(actions), model=variant)
-        except SpecError as exc:
-            errors += [line for line in (d.render(exc.sources) for d in exc.diagnostics) if line not in errors]
-            errors.append(f"{prog}: error: {bag_path}: {topic} is recorded as {type_name} too (first as "
-                          f"{info.types[topic]}): the errors above are the spec read against {type_name}")
-            continue  # said at the field's place: its class is not checked again
         try:
             types.setdefault(topic, []).append((type_name, _class_of(conn)))
         except ValueError as exc:

@@ -210,7 +210,9 @@ def test_every_recorded_type_of_a_topic_is_checked(write, tmp_path, second, said
     proc = replay(spec, bag)
     assert proc.returncode == 1, proc.stdout  # before: exit 0, the second type's messages unknown
     assert f"{spec}:3:{line.index('topic') + 1}: error: {said}" in proc.stderr
-    assert f"/speed is recorded as {type(second)._type} too (first as std_msgs/Float64)" in proc.stderr
+    note = (f"; /speed is recorded as {type(second)._type} too in {os.path.basename(bag)} (first as "
+            f"std_msgs/Float64): this is the spec read against {type(second)._type}")  # as `check --bag` says it
+    assert any(said in line and line.endswith(note) for line in proc.stderr.splitlines()), proc.stderr
     assert proc.stdout == ""
     from rubass.lang import load_spec
     from rubass.report.evidence import replay_bag
