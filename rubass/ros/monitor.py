@@ -39,6 +39,7 @@ Signals
 """
 from __future__ import annotations
 
+import os
 import queue
 import signal
 import threading
@@ -304,6 +305,12 @@ class Monitor(Reloading):
                          "~heartbeat keeps the robot stopped (ISO 3691-4: no automatic restart after a protective "
                          "stop)", path, self._withheld_text())
 
+    def _nice(self) -> str:
+        """The threads' nice value, and ~nice if it was asked for and refused (priority.py)."""
+        nice = os.getpriority(os.PRIO_PROCESS, 0)  # this thread's: set_nice gave every thread the same
+        asked = self.config.nice
+        return str(nice) if asked is None or asked == nice else f"{nice} (~nice {asked} was not permitted)"
+
     def _withheld_text(self) -> str:
         return "; ".join(f"{', '.join(w.actions)} ({w.holder})" for w in self.withheld)
 
@@ -454,6 +461,7 @@ class Monitor(Reloading):
             "failed action attempts": failures,  # every one ever, for the record (no action name has a space)
             "master": self.master_watch.state, "master re-registrations": self.master_watch.reregistrations,
             "reaction latency p50 ms": f"{lat[len(lat) // 2] * 1000:.3f}" if lat else "n/a",
+            "nice": self._nice(),
             "agents": self.agents.summary(time.monotonic()),
             "silent agents": ", ".join(self.agents.silent(time.monotonic())) or "none",
             "agents claiming one host": "; ".join(self.agents.conflicts(time.monotonic())) or "none",
