@@ -18,6 +18,27 @@ class _Stopped(BaseException):
 STOP_GRACE = 1.0  # s: nothing was started, so rospy gets this long to shut down before the process exits
 
 
+def keep_console_log() -> bool:
+    """Print the node's log lines on the console even when rospy could not set up its logging. It
+    cannot when its log folder cannot be made (ROS_LOG_DIR unwritable, or another user's folder
+    above it: rospy gives the new folder its parent's owner): it then prints one WARNING and sends
+    every later line to /rosout only, so a monitor that cannot enforce its spec said nothing where
+    it was started. True when the console handler had to be added."""
+    import logging
+
+    from rosgraph.roslogging import RosStreamHandler
+
+    rosout = logging.getLogger("rosout")
+    if any(isinstance(h, RosStreamHandler) for h in rosout.handlers):
+        return False
+    handler = RosStreamHandler()
+    handler.setFormatter(logging.Formatter("[%(name)s][%(levelname)s] %(asctime)s: %(message)s"))
+    rosout.addHandler(handler)
+    if rosout.level == logging.NOTSET or rosout.level > logging.INFO:
+        rosout.setLevel(logging.INFO)  # as ROS's logging configuration sets it
+    return True
+
+
 def wants_help(argv: Optional[List[str]]) -> bool:
     """Whether the command line asks for help (ROS remappings `name:=value` aside)."""
     args = sys.argv[1:] if argv is None else argv[1:]
@@ -57,6 +78,7 @@ def init_node(name: str, argv: Optional[List[str]], say: Callable[[str], None]) 
         for s, handler in previous.items():
             signal.signal(s, handler)
     if not (stopped or failed or rospy.is_shutdown()):
+        keep_console_log()
         return None
     say(failed or f"stopped before the ROS master at {uri} answered; nothing was started")
     code = 1 if failed else 0
