@@ -39,7 +39,6 @@ Signals
 """
 from __future__ import annotations
 
-import os
 import queue
 import signal
 import threading
@@ -77,6 +76,7 @@ from ..actions.latches import Latch, LatchFile, undeclared
 from .params import MonitorConfig, spec_warnings
 from .gcfreeze import freeze_heap
 from .timerslack import exact_timers
+from .priority import describe, thread_nice_values
 from .exiting import EXIT_GRACE, exit_within
 from .reloading import ConfigError, Reloading, StartupError
 from .topics import TopicWatcher, ros_now
@@ -93,6 +93,7 @@ def _ros_now() -> float:
 class Monitor(Reloading):
     def __init__(self, config: MonitorConfig) -> None:
         self.config = config
+        self.nice_refused = False  # ~nice was asked for and not permitted (node.py sets it)
         self.reloads = 0
         self.rejected = 0
         self.last_reload_error = ""
@@ -306,10 +307,8 @@ class Monitor(Reloading):
                          "stop)", path, self._withheld_text())
 
     def _nice(self) -> str:
-        """The threads' nice value, and ~nice if it was asked for and refused (priority.py)."""
-        nice = os.getpriority(os.PRIO_PROCESS, 0)  # this thread's: set_nice gave every thread the same
-        asked = self.config.nice
-        return str(nice) if asked is None or asked == nice else f"{nice} (~nice {asked} was not permitted)"
+        """The threads' nice value(s), and ~nice if it was asked for and refused (priority.py)."""
+        return describe(thread_nice_values(), self.config.nice, self.nice_refused)
 
     def _withheld_text(self) -> str:
         return "; ".join(f"{', '.join(w.actions)} ({w.holder})" for w in self.withheld)

@@ -56,13 +56,13 @@ def main(argv: Optional[List[str]] = None) -> int:
                           "this master's", unkeyed, state_file)
     try:
         config = read_config(lambda name, default: rospy.get_param("~" + name, default), state_file)
-        if config.nice is not None:  # before the monitor's threads start: they inherit it
-            refused = set_nice(config.nice)
-            if refused:
-                rospy.logwarn("rubass: %s", refused)
-            else:
-                rospy.loginfo("rubass: running at nice %d (~nice)", config.nice)
+        refused = set_nice(config.nice) if config.nice is not None else None  # before the monitor's threads
+        if refused:  # start: they inherit it
+            rospy.logwarn("rubass: %s", refused)
+        elif config.nice is not None:
+            rospy.loginfo("rubass: running at nice %d (~nice)", config.nice)
         monitor = Monitor(config)
+        monitor.nice_refused = bool(refused)
         monitor.setup()
     except (ParamError, ConfigError) as exc:
         rospy.logfatal("rubass: cannot start:\n%s", exc)  # on stderr and in rosout: printed once

@@ -6,7 +6,7 @@ thread its creator's, so every thread alive is set, and those started later inhe
 from __future__ import annotations
 
 import os
-from typing import Optional
+from typing import Dict, Optional
 
 
 def set_nice(nice: int) -> Optional[str]:
@@ -32,3 +32,28 @@ def set_nice(nice: int) -> Optional[str]:
         except OSError as exc:
             return f"~nice {nice}: {exc.strerror or exc}; running at nice {before}"
     return None
+
+
+def thread_nice_values() -> Dict[int, int]:
+    """Nice value -> how many of this process's threads run at it (one value unless changed from outside)."""
+    out: Dict[int, int] = {}
+    try:
+        tids = os.listdir("/proc/self/task")
+    except OSError:
+        return {os.getpriority(os.PRIO_PROCESS, 0): 1}
+    for tid in tids:
+        try:
+            with open(f"/proc/self/task/{tid}/stat") as fh:
+                value = int(fh.read().rsplit(")", 1)[1].split()[16])  # field 19, after the command's ')'
+        except (OSError, IndexError, ValueError):  # a thread that ended meanwhile
+            continue
+        out[value] = out.get(value, 0) + 1
+    return out or {os.getpriority(os.PRIO_PROCESS, 0): 1}
+
+
+def describe(values: Dict[int, int], asked: Optional[int], refused: bool) -> str:
+    """The `nice` of /diagnostics: the threads' value, or each value with its number of threads (a renice
+    from outside changes one thread only), and whether ~nice was refused."""
+    text = str(next(iter(values))) if len(values) == 1 else "mixed: " + ", ".join(
+        f"{v} ({n} thread{'s' * (n != 1)})" for v, n in sorted(values.items()))
+    return f"{text} (~nice {asked} was not permitted)" if refused and asked is not None else text

@@ -39,6 +39,22 @@ def keep_console_log() -> bool:
     return True
 
 
+def null_params(argv: List[str]) -> List[str]:
+    """The private parameters `_NAME:=VALUE` of a command line whose value YAML reads as null."""
+    import yaml
+
+    out = []
+    for arg in argv[1:]:
+        name, sep, value = arg.partition(":=")
+        if sep and name.startswith("_") and not name.startswith("__"):
+            try:
+                if yaml.safe_load(value) is None:
+                    out.append(name[1:])
+            except yaml.YAMLError:
+                continue
+    return out
+
+
 def wants_help(argv: Optional[List[str]]) -> bool:
     """Whether the command line asks for help (ROS remappings `name:=value` aside)."""
     args = sys.argv[1:] if argv is None else argv[1:]
@@ -74,6 +90,10 @@ def init_node(name: str, argv: Optional[List[str]], say: Callable[[str], None]) 
     except rospy.exceptions.ROSInitException as exc:
         if not (stopped or rospy.is_shutdown()):
             failed = f"cannot start: {exc}"
+    except TypeError as exc:  # rospy stores each _NAME:= on the master; XML-RPC has no null
+        nulls = null_params(sys.argv if argv is None else argv)
+        failed = (f"cannot start: {', '.join('~' + n for n in nulls)}: null is no parameter value (the master "
+                  f"cannot store it); leave the parameter out for its default" if nulls else f"cannot start: {exc}")
     finally:
         for s, handler in previous.items():
             signal.signal(s, handler)

@@ -184,6 +184,7 @@ def test_a_custom_plugin_that_cannot_be_imported_is_reported_at_its_library_plac
     ({"spec": "SPEC", "queue_size": "big"}, "~queue_size must be a whole number of messages from 10 to 10000000"),
     ({"spec": "SPEC", "state_file": "' '"}, "~state_file must be the path of the latch state file"),
     ({"spec": "SPEC", "nice": "high"}, "~nice must be a whole number from -20 (highest priority) to 19"),
+    ({"spec": "SPEC", "nice": "null"}, "~nice: null is no parameter value"),  # was rospy's traceback
 ])  # a missing or broken spec or library keeps the monitor up, not enforcing: test_reliability_latch.py
 def test_bad_params_exit_non_zero_before_subscribing(ros, tmp_path, params, message):
     good = spec(tmp_path, "entity a { rules: r: topic /watched.data > 1; }\nif (a.r) then { stop; }\n")

@@ -42,6 +42,9 @@ def test_every_thread_runs_at_the_nice_value_and_diagnostics_show_it(ros, tmp_pa
     assert thread_nice_values(mon.pid) == {-5}, ros.log(mon)
     assert "running at nice -5 (~nice)" in ros.log(mon)
     assert brake_after(ros, 2.0), ros.log(mon)
+    os.setpriority(os.PRIO_PROCESS, mon.pid, -3)  # as `renice -p PID`: the main thread only
+    values = monitor_values(ros)["nice"]
+    assert values.startswith("mixed: -5 (") and values.endswith("threads), -3 (1 thread)"), values
 
 
 @pytest.mark.skipif(os.geteuid() != 0 or shutil.which("setpriv") is None, reason="drops from root with setpriv")

@@ -20,10 +20,10 @@ def test_every_thread_alive_and_every_later_one_gets_the_value():
         early = threading.Thread(target=stop.wait); early.start()
         assert set_nice(os.getpriority(os.PRIO_PROCESS, 0) + 3) is None
         late = threading.Thread(target=stop.wait); late.start()
-        values = {int(open(f"/proc/self/task/{t}/stat").read().rsplit(")", 1)[1].split()[16])
-                  for t in os.listdir("/proc/self/task")}
-        stop.set()
-        print(sorted(values), len(os.listdir("/proc/self/task")))
+        tids = os.listdir("/proc/self/task")
+        values = {int(open(f"/proc/self/task/{t}/stat").read().rsplit(")", 1)[1].split()[16]) for t in tids}
+        stop.set()  # after the count: the threads then end
+        print(sorted(values), len(tids))
     """
     out = subprocess.run([sys.executable, "-c", code], cwd=ROOT, capture_output=True, text=True, timeout=30)
     assert out.returncode == 0, out.stderr
@@ -61,3 +61,25 @@ def test_a_thread_that_ended_meanwhile_is_skipped(monkeypatch):
 
     monkeypatch.setattr(priority.os, "setpriority", setpriority)
     assert priority.set_nice(5) is None and done == [12]
+
+
+def test_diagnostics_name_each_value_when_a_renice_changed_one_thread_and_a_refusal_only_when_refused():
+    """An acceptance sweep: `renice -p PID` changes the main thread only, and /diagnostics said -10 for
+    a monitor whose other 11 threads ran at 0; a ~nice granted, then changed from outside, read as refused."""
+    assert priority.describe({-10: 12}, -10, False) == "-10"
+    assert priority.describe({-10: 1, 0: 11}, None, False) == "mixed: -10 (1 thread), 0 (11 threads)"
+    assert priority.describe({0: 12}, -6, False) == "0"  # granted, then reniced from outside: not "refused"
+    assert priority.describe({0: 12}, -5, True) == "0 (~nice -5 was not permitted)"
+
+
+def test_the_threads_values_are_read_from_each_thread():
+    values = priority.thread_nice_values()
+    assert sum(values.values()) == len(os.listdir("/proc/self/task"))
+    assert os.getpriority(os.PRIO_PROCESS, 0) in values
+
+
+def test_null_private_parameters_are_named():
+    from rubass.ros.startup import null_params
+
+    argv = ["monitor", "_spec:=s.rbs", "_nice:=null", "_rate:=~", "__name:=x", "_x:=", "_q:=[", "y:=null"]
+    assert null_params(argv) == ["nice", "rate", "x"]
