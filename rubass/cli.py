@@ -14,6 +14,7 @@ from .report.command import register as register_report
 from rubass_experiments.command import register as register_experiments
 from .ros.model_command import add_source_options, build_model
 from .ros.libtypes import after_check, failed_check
+from .ros.bag import BagError
 from .ros.model_sources import load_spec_against
 from .ros.model_command import register as register_model
 from .lang.errors import Diagnostic, counted, in_text_order
@@ -30,12 +31,17 @@ def _print_diags(diags: Sequence[Diagnostic], sources: Optional[SourceSet]) -> i
 
 def cmd_check(args: argparse.Namespace) -> int:
     """Check each spec; all errors of all files are printed."""
-    model, status = build_model(args)  # --bag, --live, --model: a system model to check against
+    # --bag, --live, --model: a system model to check against (a recorded definition that cannot be
+    model, status = build_model(args, strict=False)  # read refuses only a spec that reads its topic)
     if status:
         return status
     for path in args.spec:
         try:
             checked = load_spec_against(path, args.actions, model, getattr(args, "bag", None))  # every recorded type
+        except BagError as exc:
+            print(f"rubass: error: {exc}", file=sys.stderr)
+            status = 2
+            continue
         except SpecError as exc:
             found = failed_check(exc, path, args.actions, model)
             for d, sources in found:

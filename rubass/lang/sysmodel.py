@@ -37,6 +37,7 @@ class SystemModel:
     topic_units: Dict[str, Dict[str, Dimension]] = field(default_factory=dict)
     source: str = "the system model"
     unpublished: Set[str] = field(default_factory=set)  # known topics nobody publishes (live graph)
+    broken: Dict[str, str] = field(default_factory=dict)  # topic -> why its recorded definition is unreadable
 
     def __post_init__(self) -> None:
         self.topics = {norm_topic(t): ty for t, ty in self.topics.items()}

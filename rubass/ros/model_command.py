@@ -31,7 +31,7 @@ def add_source_options(parser: argparse.ArgumentParser, for_check: bool) -> None
                                                               "joint kind (--live reads /robot_description)")
 
 
-def build_model(args: argparse.Namespace) -> Tuple[Optional[SystemModel], int]:
+def build_model(args: argparse.Namespace, strict: bool = True) -> Tuple[Optional[SystemModel], int]:
     """The model the options name (None when none), or an exit status when it cannot be had;
     problems are printed."""
     urdf = getattr(args, "urdf", None)
@@ -42,7 +42,7 @@ def build_model(args: argparse.Namespace) -> Tuple[Optional[SystemModel], int]:
     if getattr(args, "master", None) and not getattr(args, "live", False):
         print("rubass: error: --master needs --live (it names the master to ask)", file=sys.stderr)
         return None, 2
-    model, status = _build_model(args)
+    model, status = _build_model(args, strict)
     if model is None or not urdf:
         return model, status
     try:
@@ -55,10 +55,10 @@ def build_model(args: argparse.Namespace) -> Tuple[Optional[SystemModel], int]:
     return model, 0
 
 
-def _build_model(args: argparse.Namespace) -> Tuple[Optional[SystemModel], int]:
+def _build_model(args: argparse.Namespace, strict: bool = True) -> Tuple[Optional[SystemModel], int]:
     try:
         if getattr(args, "bag", None):
-            return bag_model(args.bag), 0
+            return bag_model(args.bag, strict), 0
         if getattr(args, "live", False):
             return live_model(args.master), 0
     except (BagError, LiveError) as exc:

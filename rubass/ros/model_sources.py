@@ -27,21 +27,27 @@ class LiveError(RubassError):
     """The live graph cannot be read (no master, …); the message says why, in one line."""
 
 
-def bag_model(path: str) -> SystemModel:
-    """Topics, types, definitions and (when recorded) publishing nodes of a recording."""
+def bag_model(path: str, strict: bool = True) -> SystemModel:
+    """Topics, types, definitions and (when recorded) publishing nodes of a recording. A recorded
+    definition that cannot be read is a BagError; not `strict`, it is kept in the model's `broken`
+    (load_spec_against refuses it only for a spec that reads that topic's fields)."""
     bag, info = open_bag(path)
+    broken: Dict[str, str] = {}
     try:
         registry = Registry()
         for conn in bag._connections.values():  # rosbag keeps each connection's header here
             try:
                 registry.add_full(conn.datatype, conn.msg_def)
             except DefinitionError as exc:
-                raise BagError(f"{path}: topic {conn.topic}: {exc}") from None
+                if strict:
+                    raise BagError(f"{path}: topic {conn.topic}: {exc}") from None
+                broken.setdefault(norm_topic(conn.topic), f"{path}: topic {conn.topic}: {exc}")
     finally:
         bag.close()
     # No node list: a bag names only publishers, and often as the recorder or player
     # ('/play_1633455785917753240') rather than the node that ran on the robot.
-    return SystemModel(dict(info.types), None, registry, source=f"the recording {os.path.basename(path)}")
+    return SystemModel(dict(info.types), None, registry, source=f"the recording {os.path.basename(path)}",
+                       broken=broken)
 
 
 def recorded_types(path: str) -> Dict[str, List[str]]:
@@ -64,7 +70,14 @@ def load_spec_against(path: str, actions: Sequence[str], model: Optional[SystemM
     """load_spec(path, actions, model=model); with `bag`, the recording `model` is of, the spec is read
     against every other type recorded on one of its topics as well (as `rubass replay` reads it, and
     refuses it if it cannot): each error of that reading at its place, naming the type. SpecError with
-    every error, the spec's against the topics' first types and these."""
+    every error, the spec's against the topics' first types and these. BagError when the spec reads the
+    fields of a topic whose recorded definition cannot be read (the model's `broken`)."""
+    if model is not None and model.broken:  # a definition the recording holds unreadable: only the spec
+        plain = load_spec(path, list(actions))  # that reads that topic's fields is refused (BagError)
+        read = {norm_topic(t) for t in plain.field_readers(implicit=False)}
+        unreadable = [why for topic, why in sorted(model.broken.items()) if topic in read]
+        if unreadable:
+            raise BagError("; ".join(unreadable))
     checked: Optional[CheckedSpec] = None
     failed: Optional[SpecError] = None
     try:
