@@ -96,21 +96,30 @@ def load_spec_against(path: str, actions: Sequence[str], model: Optional[SystemM
     wanted = None if checked is None else {norm_topic(t) for t in spellings(checked.topics)}
     errors = list(failed.diagnostics) if failed is not None else []
     new: List[Diagnostic] = []
+    warned = list(checked.warnings) if checked is not None else []
     for topic, kinds in sorted(kinds_of.items()):
         if wanted is not None and norm_topic(topic) not in wanted:
             continue  # a topic the spec does not read
         for type_name in kinds[1:]:
             variant = dataclasses.replace(model, topics={**model.topics, norm_topic(topic): type_name})
+            note = (f"{topic} is recorded as {type_name} too in {os.path.basename(bag)} (first as {kinds[0]}): "
+                    f"this is the spec read against {type_name}")
             try:
-                load_spec(path, list(actions), model=variant)
+                other = load_spec(path, list(actions), model=variant)
             except SpecError as exc:
-                note = (f"{topic} is recorded as {type_name} too in {os.path.basename(bag)} (first as {kinds[0]}): "
-                        f"this is the spec read against {type_name}")
                 new += [dataclasses.replace(d, message=f"{d.message}; {note}") for d in exc.diagnostics
                         if d not in errors]
+                continue
+            if checked is not None:  # a warning of one type only (stamp_age() of a type without a header) says so
+                warned = [w if w in other.warnings or w not in checked.warnings else dataclasses.replace(
+                    w, message=f"{w.message}; this holds for its {kinds[0]} messages only ({topic} is recorded as "
+                               f"{type_name} too in {os.path.basename(bag)})") for w in warned]
+                warned += [dataclasses.replace(w, message=f"{w.message}; {note}") for w in other.warnings
+                           if w not in checked.warnings]
     if failed is not None:
         raise SpecError(errors + new, failed.sources, failed.warnings) if new else failed
     assert checked is not None
+    checked.warnings[:] = warned
     if new:
         raise SpecError(new, checked.sources, checked.warnings)
     return checked
