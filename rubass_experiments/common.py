@@ -46,6 +46,17 @@ def freeze_heap() -> None:
     gc.freeze()
 
 
+def as_hardware() -> None:
+    """Run a simulated base or safety board at the monitor's priority (nice -10, as root; else as
+    started). It stands for a motor controller or a microcontroller, which do not wait for a core of
+    the robot computer: at nice 0 beside the monitor at -10, the stop's way from the monitor to the
+    simulated board once took 10 ms on the CI machine (M_L+E_R), which (b) counted as the monitor's.
+    Called first in main(), so that rospy's threads inherit it."""
+    from rubass.ros.priority import set_nice
+
+    set_nice(-10)
+
+
 def loop(hz: float, step: Callable[[], None]) -> None:
     """Call step() hz times a second until ROS shuts down (the set-up done so far frozen first)."""
     freeze_heap()

@@ -28,7 +28,7 @@ from std_msgs.msg import Float64, Header
 
 from .faults import WheelFault
 from .kinematics import DiffDrive
-from .common import loop, odometry, on_fault
+from .common import as_hardware, loop, odometry, on_fault
 from .eventlog import EventLog
 
 MUX_TIMEOUT = 0.5
@@ -81,6 +81,7 @@ class SafetyBoard:
 
 
 def main() -> None:
+    as_hardware()
     rospy.init_node("frobit_base")
     log = EventLog(rospy.get_param("~events_file", None))
     board = SafetyBoard(rospy.get_param("~board_port", ""), float(rospy.get_param("~watchdog", 0.25)), log)

@@ -18,13 +18,14 @@ from geometry_msgs.msg import Twist
 from sensor_msgs.msg import JointState
 
 from .kinematics import DiffDrive
-from .common import loop, odometry
+from .common import as_hardware, loop, odometry
 from .eventlog import EventLog
 
 MUX_TIMEOUT = 0.5
 
 
 def main() -> None:
+    as_hardware()
     rospy.init_node("mobile_base")
     log = EventLog(rospy.get_param("~events_file", None))
     area = (rospy.get_param("~x_min", -1.0), rospy.get_param("~x_max", 3.0), rospy.get_param("~y_max", 2.0))
