@@ -6,6 +6,7 @@ import math
 from dataclasses import dataclass, field
 from typing import Any, Dict, List, Optional, Sequence, Tuple
 
+MONITOR_NICE = -10  # the monitor's ~nice in every run, as docs/monitor.md advises on a busy robot computer
 
 @dataclass(frozen=True)
 class Row:

@@ -25,7 +25,7 @@ from typing import Any, Dict, List, Optional, Tuple
 
 from rubass.lang import load_spec
 from rubass.replay.run import replay
-from .rows import Row
+from .rows import MONITOR_NICE, Row
 from rubass.ros.bag import BagError, open_bag, read
 from .master import ROOT, PrivateMaster, wait_for_service
 from .eventlog import read_events
@@ -35,7 +35,6 @@ PY = "/usr/bin/python3"
 CONFIG = os.path.join(ROOT, "config")
 WARMUP = 1.5        # seconds of normal driving before the fault
 STOP_TIMEOUT = 25.0  # seconds after the fault to wait for the stop
-MONITOR_NICE = -10   # the monitor's ~nice, as docs/monitor.md advises on a busy robot computer
 
 
 @dataclass

@@ -3,6 +3,8 @@ from __future__ import annotations
 
 from typing import Any, Dict, TextIO
 
+from .rows import MONITOR_NICE
+
 TARGET_B_P99_MS = 10.0
 
 
@@ -48,8 +50,8 @@ def print_table(data: Dict[str, Any], out: TextIO) -> bool:
                      f"the recorder received the data after the base got the stop, so its receive times (the due "
                      f"instant) lagged by more than the monitor's own delay; (b) there is a lower bound, not a delay")
     refused = sum(d.get("nice_refused", False) for r in data["rows"] for d in r.get("details", ()))
-    if refused:  # the runner starts it at ~nice -10, which needs root or CAP_SYS_NICE
-        notes.append(f"the monitor ran at its starting priority in {refused} run(s), not at nice -10 "
+    if refused:  # the runner starts it at a negative ~nice, which needs root or CAP_SYS_NICE
+        notes.append(f"the monitor ran at its starting priority in {refused} run(s), not at nice {MONITOR_NICE} "
                      f"(not permitted: see a run's monitor.log)")
     slow = [(r["row"], d) for r in data["rows"] if r["row"] != "CPU" for d in r.get("details", ())
             if (d.get("b") or 0.0) * 1000 > TARGET_B_P99_MS]

@@ -44,6 +44,9 @@ class _Checker:
             i.name for d in spec.decls if isinstance(d, ast.ActionDecl) for i in d.names)
         self.active_uses: Dict[str, Set[str]] = {}  # rule key or 'b:N' -> actions its active() names
         self.attrs = AttrChecker(self.diags)
+        # (a duplicate entity, constant or rule, the first definition of its name): the duplicate is
+        # checked on its own afterwards, in place of the first (_inside_duplicates)
+        self.duplicates: List[Tuple[Any, Any]] = []
 
     def error(self, span: Span, msg: str) -> None:
         self.diags.append(Diagnostic(span, msg))
@@ -67,6 +70,9 @@ class _Checker:
                 if d.name.name in top:
                     self.error(d.name.span, f"duplicate name '{d.name.name}' ({a_noun(kind)}); first defined at "
                                             f"{top[d.name.name]}")
+                    first = self.consts.get(d.name.name) or self.entities.get(d.name.name)
+                    if first is not None and type(first) is type(d):
+                        self.duplicates.append((d, first))
                     continue
                 top[d.name.name] = d.name.span
                 if isinstance(d, ast.Const):
@@ -79,6 +85,7 @@ class _Checker:
                 if r.name.name in seen:
                     self.error(r.name.span, f"duplicate rule '{r.name.name}' in entity '{ent.name.name}'; "
                                             f"first defined at {seen[r.name.name]}")
+                    self.duplicates.append((r, self.rule_asts[f"{ent.name.name}.{r.name.name}"]))
                     continue
                 if r.name.name in self.consts:
                     self.error(r.name.span, f"rule '{r.name.name}' has the name of a constant "
@@ -382,8 +389,47 @@ TOO_DEEP = ("this expression is nested too deeply to check: a sum or product of 
             "many nested parentheses; split it into several rules (an 'and'/'or' chain may be of any length)")
 
 
+MAX_DUPLICATES_CHECKED = 20  # each is one more check of the whole spec (a duplicate in a duplicate too)
+
+
+def _without(spec: ast.Spec, first: Any) -> ast.Spec:
+    """`spec` without the definition `first` (a top-level declaration, or a rule of an entity)."""
+    decls: List[ast.Decl] = []
+    for d in spec.decls:
+        if d is first:
+            continue
+        if isinstance(d, ast.Entity) and any(r is first for r in d.rules):
+            d = dataclasses.replace(d, rules=tuple(r for r in d.rules if r is not first))
+        decls.append(d)
+    return dataclasses.replace(spec, decls=tuple(decls))
+
+
+def _inside_duplicates(c: "_Checker", spec: ast.Spec, sources: SourceSet, extra_libraries: Sequence[str],
+                       model: Optional[FieldModel], budget: List[int]) -> Tuple[List[Diagnostic], List[Diagnostic]]:
+    """The errors and warnings inside each duplicate definition: it is checked in place of the first
+    one of its name, so that fixing the name does not reveal a second round of errors. `budget`: how
+    many more such checks may run."""
+    errors: List[Diagnostic] = []
+    warnings: List[Diagnostic] = []
+    known = {(str(d.span), d.message) for d in c.diags + c.warnings}
+    for dup, first in c.duplicates:
+        if budget[0] <= 0:
+            break
+        budget[0] -= 1
+        _, diags, warns = _check(_without(spec, first), sources, extra_libraries, model, budget)
+        for found, out in ((diags, errors), (warns, warnings)):
+            for d in found:
+                inside = d.span.file == dup.span.file and dup.span.start <= d.span.start < dup.span.end
+                if inside and (str(d.span), d.message) not in known:
+                    known.add((str(d.span), d.message))
+                    out.append(d)
+    return errors, warnings
+
+
 def _check(spec: ast.Spec, sources: SourceSet, extra_libraries: Sequence[str],
-           model: Optional[FieldModel]) -> Tuple[Optional[CheckedSpec], List[Diagnostic], List[Diagnostic]]:
+           model: Optional[FieldModel], budget: Optional[List[int]] = None
+           ) -> Tuple[Optional[CheckedSpec], List[Diagnostic], List[Diagnostic]]:
+    """`budget`: how many duplicates may still be checked on their own (_inside_duplicates)."""
     c = _Checker(spec, sources, model)
     try:
         c.collect()
@@ -398,6 +444,11 @@ def _check(spec: ast.Spec, sources: SourceSet, extra_libraries: Sequence[str],
         c.attrs.check_rules(c.entities)
     except RecursionError:
         c.error(Span(spec.file, 1, 1), "expressions are nested too deeply to check")
+    if c.duplicates:
+        errors, warnings = _inside_duplicates(c, spec, sources, extra_libraries, model,
+                                              [MAX_DUPLICATES_CHECKED] if budget is None else budget)
+        c.diags.extend(errors)
+        c.warnings.extend(warnings)
     if c.diags:
         c.diags.sort(key=lambda d: (d.span.file != spec.file, d.span.file, d.span.line, d.span.col))
         return None, c.diags, c.warnings

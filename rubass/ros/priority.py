@@ -6,15 +6,20 @@ thread its creator's, so every thread alive is set, and those started later inhe
 from __future__ import annotations
 
 import os
-from typing import Dict, Optional
+from typing import Dict, List, Optional
+
+
+def _threads() -> List[int]:
+    """This process's thread ids; [0] (the process itself, to os.getpriority) where /proc is missing."""
+    try:
+        return [int(t) for t in os.listdir("/proc/self/task")]
+    except OSError:  # not Linux
+        return [0]
 
 
 def set_nice(nice: int) -> Optional[str]:
     """Give every thread of this process the nice value `nice`; None, or why it could not."""
-    try:
-        tids = [int(t) for t in os.listdir("/proc/self/task")]
-    except OSError:  # no /proc (not Linux): the process's own value
-        tids = [0]
+    tids = _threads()
     before = os.getpriority(os.PRIO_PROCESS, 0)
     for tid in tids:
         try:
@@ -37,15 +42,10 @@ def set_nice(nice: int) -> Optional[str]:
 def thread_nice_values() -> Dict[int, int]:
     """Nice value -> how many of this process's threads run at it (one value unless changed from outside)."""
     out: Dict[int, int] = {}
-    try:
-        tids = os.listdir("/proc/self/task")
-    except OSError:
-        return {os.getpriority(os.PRIO_PROCESS, 0): 1}
-    for tid in tids:
+    for tid in _threads():
         try:
-            with open(f"/proc/self/task/{tid}/stat") as fh:
-                value = int(fh.read().rsplit(")", 1)[1].split()[16])  # field 19, after the command's ')'
-        except (OSError, IndexError, ValueError):  # a thread that ended meanwhile
+            value = os.getpriority(os.PRIO_PROCESS, tid)  # Linux: a thread id names that thread alone
+        except OSError:  # a thread that ended meanwhile
             continue
         out[value] = out.get(value, 0) + 1
     return out or {os.getpriority(os.PRIO_PROCESS, 0): 1}

@@ -223,3 +223,26 @@ def test_a_long_run_of_not_is_named_where_it_starts(write):
     found = errors(write, HEAD + "entity e { rules: r: " + "not " * 1000 + "topic /v.x > 1; }\nif (e.r) then { stop; }\n")
     assert found == [(3, 22, "expressions are nested too deeply to parse (a long run of 'not' or '-' here; "
                              "two cancel out: remove pairs)")], found
+
+
+def test_errors_inside_a_duplicate_definition_are_reported_with_the_duplicate(write):
+    """A duplicate entity, constant or rule is checked too, in place of the first of its name: fixing
+    the name must not reveal a second round of errors (found in an acceptance sweep)."""
+    found = errors(write, HEAD + "const LIM = 1 m/s;\nconst LIM = 2 m/s + 1 s;\n"
+                          "entity e { rules: r: topic /v.x > LIM; }\n"
+                          "entity e { rules:\n  q: undefined_rule and topic /v.x > 1;\n"
+                          "  q: topic /v.x > 1 for 2;\n}\nif (e.r) then { stop; }\n")
+    assert [(line, m.split(";")[0]) for line, _, m in found] == [
+        (4, "duplicate name 'LIM' (a constant)"),
+        (4, "cannot add or subtract a speed and a time"),
+        (6, "duplicate name 'e' (an entity)"),
+        (7, "undefined name 'undefined_rule'"),
+        (8, "duplicate rule 'q' in entity 'e'"),
+        (8, "the duration of 'for' needs a unit of time: write '2 s'"),
+    ], found
+
+
+def test_a_duplicate_without_errors_of_its_own_adds_none(write):
+    found = errors(write, HEAD + "entity e { rules: r: topic /v.x > 1; }\nentity e { rules: r: topic /v.x > 2; }\n"
+                                 "if (e.r) then { stop; }\n")
+    assert [m.split(";")[0] for _, _, m in found] == ["duplicate name 'e' (an entity)"], found
