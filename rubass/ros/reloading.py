@@ -20,6 +20,7 @@ from ..lang.model import CheckedSpec
 from .clockjump import horizon
 from .gcfreeze import freeze_heap
 from .libtypes import render_failed_check
+from .livecheck import live_errors
 from .topics import ros_now
 
 
@@ -82,6 +83,7 @@ class Reloading:
                 self._check_overload_actions(spec)
                 self._check_actions(spec)
                 self._check_running_types(spec)
+                self._check_live_types(spec)
                 t_check = time.monotonic()
                 if self.spec is not None and self.loop is None:
                     raise StartupError(f"not enforcing yet: {self._why_not()}; reload once it enforces")
@@ -179,6 +181,17 @@ class Reloading:
         errors = running_type_changes(running, new, rospy.resolve_name)
         if errors:
             raise StartupError("\n".join(d.render(spec.sources) for d in errors))
+
+    def _check_live_types(self, spec: CheckedSpec) -> None:
+        """The new spec against the message types its topics carry now, as `rubass check --live`:
+        a field the type lacks would read unknown from the swap on (an active stop released for a
+        typo), and a unit or kind error is an error too; the running rules are kept instead."""
+        watcher = getattr(self, "watcher", None)  # none before the first spec is enforced
+        types = watcher.carried_types() if watcher is not None else {}
+        errors = live_errors(spec, self.config.actions, types) if types else []
+        if errors:
+            raise StartupError("the new spec does not fit the message types its topics carry now (as "
+                               "`rubass check --live` reads them):\n" + "\n".join(errors))
 
     def _load_stable(self) -> CheckedSpec:
         """load_spec, again if a file changed while it was read or within the last 50 ms (an
