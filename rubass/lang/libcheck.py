@@ -3,7 +3,8 @@ service type exists, and every field of `message:`, `on_release:` and `request:`
 value of a fitting type. Errors point at the YAML file and line."""
 from __future__ import annotations
 
-from typing import Any, Callable, Dict, Iterable, List, Optional, Tuple
+import struct
+from typing import Any, Callable, Dict, Iterable, List, Optional, Set, Tuple
 
 import yaml
 
@@ -14,6 +15,11 @@ from .source import SourceSet, Span
 from .yamltags import plain_value
 
 _FLOATS = ("float32", "float64")
+_MERGE = "tag:yaml.org,2002:merge"
+# what genpy serialises: a time's secs and nsecs are uint32, a duration's int32; a whole number of
+# nanoseconds becomes those (a time's must not be negative)
+_TIME_PARTS = {"time": "uint32", "duration": "int32"}
+_TIME_NS = {"time": (0, 4294967295 * 10 ** 9), "duration": (-2147483648 * 10 ** 9, 2147483647 * 10 ** 9)}
 
 
 def _span(node: yaml.Node, file: str) -> Span:
@@ -21,10 +27,25 @@ def _span(node: yaml.Node, file: str) -> Span:
     return Span(file, m.line + 1, m.column + 1, m.index, node.end_mark.index)
 
 
-def _entries(node: Optional[yaml.Node]) -> Dict[str, Tuple[yaml.Node, yaml.Node]]:
+def _entries(node: Optional[yaml.Node], seen: Optional[Set[int]] = None) -> Dict[str, Tuple[yaml.Node, yaml.Node]]:
+    """A mapping's keys -> (key node, value node), with what it takes from others by merge keys
+    (`<<: *base`, as the library's loader does: its own keys win, then the first merged)."""
     if not isinstance(node, yaml.MappingNode):
         return {}
-    return {str(k.value): (k, v) for k, v in node.value if isinstance(k, yaml.ScalarNode)}
+    seen = (seen or set()) | {id(node)}
+    own: Dict[str, Tuple[yaml.Node, yaml.Node]] = {}
+    merged: Dict[str, Tuple[yaml.Node, yaml.Node]] = {}
+    for k, v in node.value:
+        if not isinstance(k, yaml.ScalarNode):
+            continue
+        if k.tag == _MERGE:
+            for m in (v.value if isinstance(v, yaml.SequenceNode) else [v]):
+                if id(m) not in seen:
+                    for key, pair in _entries(m, seen).items():
+                        merged.setdefault(key, pair)
+        else:
+            own[str(k.value)] = (k, v)
+    return {**merged, **own}
 
 
 def _action_nodes(sources: SourceSet, act: ActionDef) -> Dict[str, Tuple[yaml.Node, yaml.Node]]:
@@ -91,11 +112,14 @@ class _FieldChecker:
                 self.message(spec, node, where)
             return
         if f.type in ("time", "duration") and isinstance(node, yaml.MappingNode):
+            part = _TIME_PARTS[f.type]
             for key, (knode, vnode) in _entries(node).items():
                 if key not in ("secs", "nsecs"):
                     self.error(knode, f"'{where}' is a {f.type}: its fields are secs and nsecs, not '{key}'")
-                elif _primitive_problem("int32", _scalar(vnode)):
-                    self.error(vnode, f"'{where}.{key}' must be a whole number, got {_show(vnode)}")
+                elif _primitive_problem(part, _scalar(vnode)):
+                    lo, hi = INTEGERS[part]
+                    self.error(vnode, f"'{where}.{key}' is a {part}: give a whole number from {lo} to {hi}, "
+                                      f"got {_show(vnode)}")
             return
         value = _scalar(node)
         problem = _primitive_problem(f.type, value)
@@ -122,8 +146,10 @@ def _show(node: yaml.Node) -> str:
 
 def _primitive_problem(ftype: str, v: Any) -> Optional[str]:
     if ftype in ("time", "duration"):
-        return None if isinstance(v, int) and not isinstance(v, bool) else \
-            "give {secs: S, nsecs: N} or a whole number of nanoseconds"
+        if isinstance(v, bool) or not isinstance(v, int):
+            return "give {secs: S, nsecs: N} or a whole number of nanoseconds"
+        lo, hi = _TIME_NS[ftype]
+        return None if lo <= v <= hi else f"a whole number of nanoseconds must be from {lo} to {hi}"
     if ftype == "bool":
         return None if isinstance(v, bool) or v in (0, 1) and isinstance(v, int) else "give true or false"
     if ftype == "string":
@@ -131,7 +157,13 @@ def _primitive_problem(ftype: str, v: Any) -> Optional[str]:
     if ftype in _FLOATS:
         if isinstance(v, float) and v != v:  # .nan: a stop command of NaN is no command a base can follow
             return "a command must be a number (NaN is not one)"
-        return None if isinstance(v, (int, float)) and not isinstance(v, bool) else "give a number"
+        if isinstance(v, bool) or not isinstance(v, (int, float)):
+            return "give a number"
+        try:
+            struct.pack("<f" if ftype == "float32" else "<d", v)
+        except (OverflowError, struct.error):
+            return f"too large for a {ftype} (at most {3.4028234663852886e38 if ftype == 'float32' else 1.7976931348623157e308:.8g})"
+        return None
     lo, hi = INTEGERS[ftype]
     if isinstance(v, bool) or not isinstance(v, int):
         return f"give a whole number from {lo} to {hi}"

@@ -85,6 +85,17 @@ def test_a_library_that_fits_its_types():
     ("type: my_msgs/Board\n    message: {header: {stamp: now}}",
      "6:31: action 'a': 'message.header.stamp' is a time: give {secs: S, nsecs: N} or a whole number of "
      "nanoseconds, got 'now'"),
+    # values genpy cannot serialise, which the monitor refused at start with no place (acceptance sweep)
+    ("type: my_msgs/Board\n    message: {limits: [1.0e+39]}",
+     "6:24: action 'a': 'message.limits[0]' is a float32: too large for a float32 (at most 3.4028235e+38), got 1e+39"),
+    ("type: geometry_msgs/Twist\n    message: {linear: {x: 1" + "0" * 400 + "}}",
+     "6:27: action 'a': 'message.linear.x' is a float64: too large for a float64 (at most 1.7976931e+308), got 1"
+     + "0" * 400),
+    ("type: my_msgs/Board\n    message: {header: {stamp: {secs: -1}}}",
+     "6:38: action 'a': 'message.header.stamp.secs' is a uint32: give a whole number from 0 to 4294967295, got -1"),
+    ("type: my_msgs/Board\n    message: {header: {stamp: -5}}",
+     "6:31: action 'a': 'message.header.stamp' is a time: a whole number of nanoseconds must be from 0 to "
+     "4294967295000000000, got -5"),
     ("type: my_msgs/Board\n    on_release: {brake: off, mood: 1}",
      "6:30: action 'a': my_msgs/Board has no field 'mood'; did you mean 'mode'? (its fields: header, mode, brake, why, pwm, limits, raw)"),
 ])
@@ -106,3 +117,13 @@ def test_publish_topic_of_another_type_in_the_model():
     assert check(GOOD, {"/cmd_vel": "geometry_msgs/TwistStamped", "/board": "my_msgs/Board"}) == [
         "5:11: action 'stop': publishes geometry_msgs/Twist on /cmd_vel, which carries "
         "geometry_msgs/TwistStamped in the test model: its subscribers would refuse the connection"]
+
+
+def test_values_a_merge_key_brings_in_are_checked_at_their_place():
+    """`brake: {<<: *stop, type: std_msgs/Float64}` inherits stop's Twist message: the monitor refused it
+    at start, `rubass check` said ok (acceptance sweep)."""
+    text = ("actions:\n  stop: &s\n    plugin: publish\n    topic: /t\n    type: geometry_msgs/Twist\n"
+            "    message: {linear: {x: 0}}\n  board: {<<: *s, topic: /b, type: my_msgs/Board}\n"
+            "  slow: {<<: *s, topic: /s, message: {<<: {linear: {x: 0.1}}, angular: {z: 0}}}\n")
+    assert check(text) == ["6:15: action 'board': my_msgs/Board has no field 'linear' (its fields: header, mode, "
+                           "brake, why, pwm, limits, raw)"]
