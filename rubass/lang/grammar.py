@@ -388,6 +388,17 @@ def _found(text: str, loc: int) -> str:
     return f"'{m.group(0)}'" if m else "end of file"
 
 
+_UNIT_CHARACTERS = {"\u00b0": "write degC for a temperature, deg for an angle",
+                    "\u00b5": "write us for microseconds", "\u03bc": "write us for microseconds"}
+
+
+def _unit_character(text: str, loc: int) -> str:
+    """A hint when a unit is written with a character the language has none of ('°C', 'µs')."""
+    m = re.match(r"\s*(\S)", text[loc:])
+    hint = _UNIT_CHARACTERS.get(m.group(1)) if m else None
+    return f" ('{m.group(1)}' is no character of the language: {hint})" if m and hint else ""
+
+
 def _bad_index(text: str, loc: int) -> Optional[str]:
     """The message for a '[' after a field path that is no index, slice or [*] (None otherwise)."""
     if not text.startswith("[", loc) or not re.search(rf"\btopic\s+{_GRAPH_RE}{_PATH_RE}\Z", text[max(0, loc - 300):loc]):
@@ -426,7 +437,8 @@ def parse_source(source: Source, fast: bool = True) -> ast.Spec:
         except pp.ParseBaseException as exc:
             msg = exc.msg
             if msg.startswith("Expected "):
-                msg = _bad_index(text, exc.loc) or f"expected {msg[len('Expected '):]}, found {_found(text, exc.loc)}"
+                msg = _bad_index(text, exc.loc) or f"expected {msg[len('Expected '):]}, found {_found(text, exc.loc)}" \
+                    + _unit_character(text, exc.loc)
             raise _error(source, exc.loc, msg) from None
         except RecursionError:
             loc, depth = _deepest(text)

@@ -127,7 +127,9 @@ def parse_quantity(text: str) -> Optional[Tuple[float, Dimension]]:
 _SPELLINGS = {"sec": "s", "secs": "s", "second": "s", "seconds": "s", "msec": "ms", "hr": "h", "hrs": "h",
               "hour": "h", "hours": "h", "meter": "m", "meters": "m", "metre": "m", "metres": "m",
               "degree": "deg", "degrees": "deg", "radian": "rad", "radians": "rad", "hz": "Hz", "mins": "min",
-              "mps": "m/s", "kph": "km/h", "kmh": "km/h"}
+              "mps": "m/s", "kph": "km/h", "kmh": "km/h", "C": "degC", "celsius": "degC", "volt": "V",
+              "volts": "V", "v": "V", "amp": "A", "amps": "A", "ampere": "A", "amperes": "A", "pascal": "Pa", "degc": "degC"}
+_WRITABLE = [u for u in UNITS if u.isascii()]  # what a spec can write ('°C' is for YAML; the spec writes degC)
 
 
 def _unit_part(text: str) -> Optional[Tuple[float, Dimension]]:
@@ -163,9 +165,11 @@ def unit_suggestion(unit: str) -> str:
 
     if any(not re.fullmatch(r"0*[1-9]\d*", power) for power in re.findall(r"\^([^/*]*)", unit)):
         return ""  # 's^0', 's^-1', 's^x': no unit of rubass means it, and none is as good as a wrong one
+    if unit == "K" or unit.lower() == "kelvin":
+        return "; rubass has no kelvin: a temperature is written in degC"
     meant = _compound(unit) if "/" in unit else _unit_part(unit) if "^" in unit else None
     if meant is not None:  # its dimension is known: only a unit of that dimension is suggested
-        same = [u for u, (f, d) in UNITS.items() if d == meant[1]]
+        same = [u for u in _WRITABLE if UNITS[u][1] == meant[1]]
         exact = [u for u in same if abs(UNITS[u][0] - meant[0]) <= 1e-9 * meant[0]]
         if exact:
             return f"; did you mean '{exact[0]}'?"
@@ -175,8 +179,8 @@ def unit_suggestion(unit: str) -> str:
     alone = _SPELLINGS.get(unit, _SPELLINGS.get(unit.lower()))
     if alone is not None:
         return f"; did you mean '{alone}'?"
-    pool = sorted(u for u in UNITS if ("/" in u) == ("/" in unit) and _parts_agree(unit, u)) or \
-        sorted(u for u in UNITS if _parts_agree(unit, u))
+    pool = sorted(u for u in _WRITABLE if ("/" in u) == ("/" in unit) and _parts_agree(unit, u)) or \
+        sorted(u for u in _WRITABLE if _parts_agree(unit, u))
     close = difflib.get_close_matches(unit, pool, n=1, cutoff=0.6)
     return f"; did you mean '{close[0]}'?" if close else ""
 

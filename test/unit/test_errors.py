@@ -246,3 +246,18 @@ def test_a_duplicate_without_errors_of_its_own_adds_none(write):
     found = errors(write, HEAD + "entity e { rules: r: topic /v.x > 1; }\nentity e { rules: r: topic /v.x > 2; }\n"
                                  "if (e.r) then { stop; }\n")
     assert [m.split(";")[0] for _, _, m in found] == ["duplicate name 'e' (an entity)"], found
+
+
+@pytest.mark.parametrize("unit,expected", [
+    ("C", "unknown unit 'C'; did you mean 'degC'?"),
+    ("degc", "unknown unit 'degc'; did you mean 'degC'?"),
+    ("volts", "unknown unit 'volts'; did you mean 'V'?"),
+    ("K", "unknown unit 'K'; rubass has no kelvin: a temperature is written in degC"),
+    ("°C", "expected ';', found '°C;' ('°' is no character of the language: write degC for a temperature, "
+           "deg for an angle)"),
+    ("µs", "expected ';', found 'µs;' ('µ' is no character of the language: write us for microseconds)"),
+])
+def test_a_unit_suggestion_is_one_the_spec_can_write(write, unit, expected):
+    """'60 C' suggested '°C', which does not parse (acceptance sweep): a spec writes degC."""
+    found = errors(write, HEAD + f"entity e {{ rules: r: topic /t.data > 60 {unit}; }}\nif (e.r) then {{ stop; }}\n")
+    assert [m for _, _, m in found] == [expected], found
