@@ -19,6 +19,7 @@ import roslib.message
 import rospy
 
 from ...actions.clamp import AXES, clamp_twist
+from ..reach import Reach
 from .arbiter import take_seat
 from ...actions.base import ActionPlugin, Context, Skipped
 from ...actions.status import NOTHING_DONE, RESOLVED
@@ -46,6 +47,7 @@ class LimitPlugin(ActionPlugin):
         self._due = False  # publish at the next periodic although a command is fresh (handed the topic)
         self._pub_at = float("-inf")  # this action's latest publication (time.monotonic())
         self._last_log = float("-inf")
+        self.reach = Reach()
         self.input_errors = 0
         self.pub: Optional[rospy.Publisher] = None
         self.sub: Optional[rospy.Subscriber] = None
@@ -92,8 +94,8 @@ class LimitPlugin(ActionPlugin):
         if reached < 0:  # a higher-priority action owns the topic: nothing proved; retried, not counted
             raise Skipped(f"{self.params['topic']} is held by a higher-priority action")
         if reached == 0:
-            raise IOError(f"no node subscribes to {self.params['topic']}: the limited command reached no one; "
-                          f"commands go on being published as they come")
+            raise IOError(f"{self.reach.why(self.params['topic'], self.type)}: the limited command reached no "
+                          f"one; commands go on being published as they come")
 
     def periodic(self) -> None:
         with self._lock:

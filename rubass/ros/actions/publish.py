@@ -8,6 +8,7 @@ import genpy
 import roslib.message
 import rospy
 
+from ..reach import Reach
 from .arbiter import take_seat
 from ...actions.base import ActionPlugin, ActionSetupError, Context, Skipped
 from ...actions.status import NOTHING_DONE
@@ -62,6 +63,7 @@ class PublishPlugin(ActionPlugin):
         self.period = 1.0 / float(self.params["rate"])
         self.pub: Optional[rospy.Publisher] = None
         self.seat: Any = None
+        self.reach = Reach()
 
     def setup(self) -> None:
         cls = ros_class(roslib.message.get_message_class, self.params["type"], f"action '{self.name}'", "message")
@@ -100,8 +102,8 @@ class PublishPlugin(ActionPlugin):
             # not an error rospy would report: the message just went nowhere. A failure, so it is
             # logged, counted in /diagnostics and retried (0.05 s, 0.1 s, … then every 1 s); the
             # periodic publication also reaches a subscriber that connects later.
-            raise IOError(f"no node subscribes to {self.params['topic']}: the message reached no one; "
-                          f"it is sent again as soon as one does")
+            raise IOError(f"{self.reach.why(self.params['topic'], self.params['type'])}: the message reached "
+                          f"no one; it is sent again as soon as one does")
 
     def periodic(self) -> None:
         if self.active and self.pub is not None:
