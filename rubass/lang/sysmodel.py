@@ -139,14 +139,20 @@ def graph_warnings(spec: ast.Spec, model: SystemModel) -> List[Diagnostic]:
     with a did-you-mean from the model's names. Relative names are taken from the root."""
     out: List[Diagnostic] = []
     seen = set()
+    undefined = set()
     for ref in sorted(_topic_refs(spec), key=lambda r: (r.span.line, r.span.col)):
         name = norm_topic(ref.topic)
+        type_name = model.topics.get(name)
+        if ref.path and type_name is not None and name not in undefined and model.registry.get(type_name) is None:
+            undefined.add(name)  # a hung publisher of a type not installed here: no definition to check with
+            out.append(Diagnostic(ref.span, f"the fields of topic '{ref.topic}' cannot be checked: {model.source} "
+                                            f"gives no definition of {type_name}", "warning"))
         if name in seen or (name in model.topics and name not in model.unpublished):
             continue
         seen.add(name)
         if name in model.topics:
-            out.append(Diagnostic(ref.span, f"topic '{ref.topic}' has no publisher in {model.source} "
-                                            "(only subscribers): its data would never come", "warning"))
+            out.append(Diagnostic(ref.span, f"topic '{ref.topic}' has no publisher in {model.source}: "
+                                            "its data would never come", "warning"))
             continue
         out.append(Diagnostic(ref.span, f"topic '{ref.topic}' is not in {model.source}"
                                         f"{did_you_mean(name, model.topics)}", "warning"))

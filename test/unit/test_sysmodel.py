@@ -253,7 +253,18 @@ def test_a_topic_nobody_publishes_is_a_warning():
     spec = parse_source(Source("s.rbs", SPEC.replace("/cmd_vell", "/scan")))
     warnings = graph_warnings(spec, model(unpublished={"scan"}))
     assert [f"{d.span}: {d.message}" for d in warnings] == [
-        "s.rbs:4:11: topic '/scan' has no publisher in the system model (only subscribers): its data would never come"]
+        "s.rbs:4:11: topic '/scan' has no publisher in the system model: its data would never come"]
+
+
+def test_fields_of_a_topic_whose_type_has_no_definition_are_a_warning_once():
+    """`check --live` with a publisher whose definition could not be read (hung, type not installed) said
+    ok and checked nothing of it; `model --live` warned (acceptance sweep)."""
+    text = ("action primitive stop;\nentity e { rules:\n  a: topic /ghost.levl > 1;\n  b: topic /ghost.x > 2;\n"
+            "  c: age(topic /ghost) > 1 s;\n}\nif (e.a) then { stop; }\n")
+    warnings = graph_warnings(parse_source(Source("s.rbs", text)), model())
+    assert [f"{d.span}: {d.message}" for d in warnings] == [
+        "s.rbs:3:6: the fields of topic '/ghost' cannot be checked: the system model gives no definition of "
+        "ghost_msgs/Ghost"]
 
 
 def test_urdf_joint_kinds():
