@@ -82,7 +82,7 @@ def a_noun(noun: str) -> str:
     if any(c in noun for c in "*^") or not noun[:1].isalpha():  # a formula of units, such as m*s or m^3
         return f"a quantity in {noun}"
     low = noun.lower()
-    vowel = low[:1] in "aeiou" and not low.startswith(("uni", "use", "usu", "one", "eu"))  # 'a unit'
+    vowel = low[:1] in "aeiou" and not low.startswith(("uni", "uint", "use", "usu", "one", "eu"))  # 'a unit'
     return ("an " if vowel else "a ") + noun
 
 

@@ -8,7 +8,7 @@ from typing import Any, Callable, Dict, Iterable, List, Optional, Set, Tuple
 
 import yaml
 
-from .errors import Diagnostic, did_you_mean
+from .errors import Diagnostic, a_noun, did_you_mean
 from .library import TWIST_TYPES, ActionDef
 from .msgdef import INTEGERS, FieldDef, MsgSpec, Registry
 from .source import SourceSet, Span
@@ -101,7 +101,7 @@ class _FieldChecker:
                 self.error(node, f"'{where}' is an array ({f.type}[]): give a list, got {_show(node)}")
                 return
             if f.length is not None and len(node.value) != f.length:
-                self.error(node, f"'{where}' is a {f.type}[{f.length}]: give exactly {f.length} values, "
+                self.error(node, f"'{where}' is {a_noun(f'{f.type}[{f.length}]')}: give exactly {f.length} values, "
                                  f"got {len(node.value)}")
             for i, v in enumerate(node.value):
                 self.field(FieldDef(f.name, f.type), v, f"{where}[{i}]")
@@ -115,16 +115,16 @@ class _FieldChecker:
             part = _TIME_PARTS[f.type]
             for key, (knode, vnode) in _entries(node).items():
                 if key not in ("secs", "nsecs"):
-                    self.error(knode, f"'{where}' is a {f.type}: its fields are secs and nsecs, not '{key}'")
+                    self.error(knode, f"'{where}' is {a_noun(f.type)}: its fields are secs and nsecs, not '{key}'")
                 elif _primitive_problem(part, _scalar(vnode)):
                     lo, hi = INTEGERS[part]
-                    self.error(vnode, f"'{where}.{key}' is a {part}: give a whole number from {lo} to {hi}, "
+                    self.error(vnode, f"'{where}.{key}' is {a_noun(part)}: give a whole number from {lo} to {hi}, "
                                       f"got {_show(vnode)}")
             return
         value = _scalar(node)
         problem = _primitive_problem(f.type, value)
         if problem:
-            self.error(node, f"'{where}' is a {f.type}: {problem}, got {_show(node)}")
+            self.error(node, f"'{where}' is {a_noun(f.type)}: {problem}, got {_show(node)}")
 
 
 _NOT_SCALAR = object()

@@ -7,7 +7,7 @@ from typing import Any, Iterable, List, Optional, Tuple
 
 import yaml
 
-from .errors import did_you_mean
+from .errors import a_noun, did_you_mean
 from .msgdef import PRIMITIVES, Registry, definition_lines
 from .yamltags import duplicate_keys
 
@@ -74,9 +74,9 @@ def unit_path_problem(registry: Registry, root: str, path: str) -> Optional[str]
             return (f"{at} has no field '{name}'{did_you_mean(name, spec.names)} "
                     f"(its fields: {', '.join(spec.names) or 'none'})")
         if found.is_primitive and i + 1 < len(names):
-            return f"'{'.'.join(names[:i + 1])}' is a {found.type}, not a message: it has no field '{names[i + 1]}'"
+            return f"'{'.'.join(names[:i + 1])}' is {a_noun(found.type)}, not a message: it has no field '{names[i + 1]}'"
         current = found.type
         if i + 1 == len(names) and (not found.is_primitive or found.type in ("string", "bool")):
             what = "a message" if not found.is_primitive else "not a number"
-            return f"'{path}' is a {found.type}{'[]' if found.is_array else ''}, {what}: it takes no unit"
+            return f"'{path}' is {a_noun(found.type + ('[]' if found.is_array else ''))}, {what}: it takes no unit"
     return None

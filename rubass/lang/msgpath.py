@@ -5,7 +5,7 @@ from __future__ import annotations
 from typing import Dict, List, Optional, Sequence, Tuple
 
 from .ast import PathElem, Slice, path_suffix
-from .errors import did_you_mean
+from .errors import a_noun, did_you_mean
 from .fieldmodel import FieldInfo
 from .msgdef import FieldDef, Registry
 from .units import TIME, Dimension
@@ -50,7 +50,7 @@ def resolve(registry: Registry, root: str, path: Sequence[PathElem], tables: Seq
             return FieldInfo("missing", why=f"{where} is an array ({current.type}[]): index it, e.g. "
                                             f"'{path_suffix(done + (0, elem)).lstrip('.')}'")
         if current is not None and current.is_primitive:
-            return FieldInfo("missing", why=f"{where} is a {current.type}, not a message: it has no field '{elem}'")
+            return FieldInfo("missing", why=f"{where} is {a_noun(current.type)}, not a message: it has no field '{elem}'")
         owner = root if current is None else current.type
         spec = registry.get(owner)
         if spec is None:
@@ -76,14 +76,14 @@ def resolve(registry: Registry, root: str, path: Sequence[PathElem], tables: Seq
         if not found.is_primitive:
             anchors.append((found.type, []))
     if current is None:
-        return FieldInfo("msg", why=f"it is a {root} (fields: {', '.join(_names(registry, root))})")
+        return FieldInfo("msg", why=f"it is {a_noun(root)} (fields: {', '.join(_names(registry, root))})")
     if current.type in ("time", "duration"):
         dim = TIME
     if in_array:
         return FieldInfo("array", dim, why=f"{current.type}[{current.length if current.length is not None else ''}]",
                          elem_kind="msg" if not current.is_primitive else _prim_kind(current.type))
     if not current.is_primitive:
-        return FieldInfo("msg", why=f"it is a {current.type} (fields: {', '.join(_names(registry, current.type))})")
+        return FieldInfo("msg", why=f"it is {a_noun(current.type)} (fields: {', '.join(_names(registry, current.type))})")
     kind = _prim_kind(current.type)
     if mapped:
         return FieldInfo("array", dim if kind == "num" else None, elem_kind=kind)

@@ -35,7 +35,7 @@ def test_a_good_hand_written_model_with_units_of_its_fields():
     ("topics: {}\nunits:\n  acme_msgs/Pack: {pack_voltage.x: V}\n",
      "3:20: the units of acme_msgs/Pack: 'pack_voltage' is a float32, not a message: it has no field 'x'"),
     ("topics: {}\nunits:\n  acme_msgs/Pack: {cells: V}\n",
-     "3:20: the units of acme_msgs/Pack: 'cells' is a acme_msgs/Cell[], a message: it takes no unit"),
+     "3:20: the units of acme_msgs/Pack: 'cells' is an acme_msgs/Cell[], a message: it takes no unit"),
 ])
 def test_units_of_a_field_the_definition_lacks_are_errors_at_the_field(units, expected):
     assert problems(units + PACK) == [expected]

@@ -39,10 +39,17 @@ class Pub:
         return self.subscribers
 
 
+class NoSubscriber:
+    def why(self, topic, published):
+        return f"no node subscribes to {topic}"
+
+
 def plugin(mine, subscribers=1):
     p = PublishPlugin.__new__(PublishPlugin)  # start and release only: no master, no rospy publisher
     p.msg, p.stamp, p.params = object(), False, {"topic": "/cmd"}
     p.release_msg, p.release_stamp, p.pub, p.seat = object(), False, Pub(subscribers), Seat(mine)
+    p.params["type"] = "std_msgs/Bool"
+    p.reach = NoSubscriber()  # the master is not asked here: test/integration/test_publish_wrong_type.py
     return p
 
 

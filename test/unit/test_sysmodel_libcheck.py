@@ -77,7 +77,7 @@ def test_a_library_that_fits_its_types():
     ("type: my_msgs/Board\n    message: {why: 3}",
      "6:20: action 'a': 'message.why' is a string: give a string (quote it), got 3"),
     ("type: my_msgs/Board\n    message: {pwm: [1, 2]}",
-     "6:20: action 'a': 'message.pwm' is a int16[3]: give exactly 3 values, got 2"),
+     "6:20: action 'a': 'message.pwm' is an int16[3]: give exactly 3 values, got 2"),
     ("type: my_msgs/Board\n    message: {limits: 3}",
      "6:23: action 'a': 'message.limits' is an array (float32[]): give a list, got 3"),
     ("type: my_msgs/Board\n    message: {limits: [1, x]}",
