@@ -95,8 +95,7 @@ class Dispatcher:
         witness = getattr(e, "witness", None)
         if witness is not None:  # why it started: name, attributes, true rules and the values they read
             record.update(witness.as_json())
-            why = "; ".join([f"true: {', '.join(witness.rules)}"] * bool(witness.rules)
-                            + [r.text() for r in witness.readings])
+            why = "; ".join([witness.causes()] * bool(witness.causes()) + [r.text() for r in witness.readings])
             who = (witness.name or f"behaviour {e.behaviour}") + (f" {format_attrs(b.attrs)}" if b.attrs else "")
             self.last_start = f"{who} at {e.time:.3f} s" + (f": {why}" if why else "")
         self.report(record)

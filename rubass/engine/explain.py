@@ -1,4 +1,5 @@
-"""Why a behaviour started: its true rules and the values they read, taken at the transition.
+"""Why a behaviour started: its true rules (and the rules it reads under `not` that were false) and
+the values they read, taken at the transition.
 
 A witness is computed only when a behaviour starts (never for a message that starts nothing),
 with readers compiled when the engine is built, so a start only reads values: the rules its
@@ -50,12 +51,14 @@ class Reading:
 
 @dataclass(frozen=True)
 class Witness:
-    """What made a behaviour start: its attributes, the true rules and the values read."""
+    """What made a behaviour start: its attributes, the true rules and the values read; `false_rules`:
+    the rules the condition reads under `not` that were false (`if (not zone.in_cell)`: the cause)."""
 
     rules: Tuple[str, ...]
     readings: Tuple[Reading, ...]
     attrs: Tuple[Tuple[str, Tuple[str, ...]], ...] = ()
     name: str = ""  # the behaviour's name (§14), "" when unnamed
+    false_rules: Tuple[str, ...] = ()
 
     def values(self) -> Dict[str, Any]:
         """term -> value (None when unknown) as JSON shows them: valid JSON has no infinity, so an
@@ -70,7 +73,14 @@ class Witness:
         out: Dict[str, Any] = {"name": self.name} if self.name else {}
         out.update({"rules": list(self.rules), "witnesses": self.values(), "units": self.units(),
                     "attrs": {k: list(v) for k, v in self.attrs}})
+        if self.false_rules:
+            out["false_rules"] = list(self.false_rules)
         return out
+
+    def causes(self) -> str:
+        """'true: a, b; false: c' (what a log line or a report says of the rules), '' when none."""
+        return "; ".join(f"{what}: {', '.join(keys)}" for what, keys in
+                         (("true", self.rules), ("false", self.false_rules)) if keys)
 
 
 _NODE_UNITS = {"cpu": "cores", "memory": "B", "alive": ""}
@@ -175,10 +185,10 @@ class Explainer:
     def explain(self, index: int) -> Witness:
         """The witness of behaviour `index` (1-based) at the store's current instant."""
         b = self.spec.behaviours[index - 1]
-        true_rules = self._true_rules(b.cond)
+        true_rules, false_rules = self._causes(b.cond)
         readings: List[Reading] = []
         seen = set()
-        for owner in [b.cond] + [self._rules[k].expr for k in true_rules]:
+        for owner in [b.cond] + [self._rules[k].expr for k in true_rules + false_rules]:
             for term, unit, read in self._readers_of(owner):
                 if term in seen:
                     continue
@@ -190,18 +200,20 @@ class Explainer:
                 if value is not _ARRAY:
                     readings.append(Reading(term, value, unit))
         attrs = tuple(sorted((k, tuple(v)) for k, v in (getattr(b, "attrs", None) or {}).items()))
-        return Witness(tuple(true_rules), tuple(readings), attrs, getattr(b, "name", "") or "")
+        return Witness(tuple(true_rules), tuple(readings), attrs, getattr(b, "name", "") or "", tuple(false_rules))
 
-    def _true_rules(self, cond: ast.Expr) -> List[str]:
-        out: List[str] = []
-        stack = _rule_refs(cond)
+    def _causes(self, cond: ast.Expr) -> Tuple[List[str], List[str]]:
+        """The rules that made `cond` true, directly or through other rules: those read as they are that
+        were true, and those read under `not` (an odd number of them) that were false."""
+        found: Dict[bool, List[str]] = {True: [], False: []}
+        stack = _rule_refs(cond, True)
         while stack:
-            key = stack.pop(0)
-            if key in out or self.store.rules.get(key) is not True or key not in self._rules:
+            key, positive = stack.pop(0)
+            if key in found[positive] or self.store.rules.get(key) is not positive or key not in self._rules:
                 continue
-            out.append(key)
-            stack.extend(_rule_refs(self._rules[key].expr))
-        return out
+            found[positive].append(key)
+            stack.extend(_rule_refs(self._rules[key].expr, positive))
+        return found[True], found[False]
 
     def _readers_of(self, expr: ast.Expr) -> List[Tuple[str, str, Callable[[], Any]]]:
         key = id(expr)
@@ -237,8 +249,18 @@ def _as_count(read: Callable[[], Any]) -> Callable[[], Any]:
     return count
 
 
-def _rule_refs(expr: ast.Expr) -> List[str]:
-    return [e.key for e in ast.walk(expr) if isinstance(e, ast.RuleRef)]
+def _rule_refs(expr: ast.Expr, positive: bool) -> List[Tuple[str, bool]]:
+    """The rules `expr` reads, in ast.walk's order, each with whether it is read as it is (True) or under
+    an odd number of `not` (False), `expr` itself read as `positive`."""
+    out: List[Tuple[str, bool]] = []
+    stack = [(expr, positive)]
+    while stack:
+        e, pos = stack.pop()
+        if isinstance(e, ast.RuleRef):
+            out.append((e.key, pos))
+        flip = isinstance(e, ast.Unary) and e.op == "not"
+        stack.extend((c, pos != flip) for c in ast.children(e))
+    return out
 
 
 def _terms(expr: ast.Expr) -> Sequence[ast.Expr]:

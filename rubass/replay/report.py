@@ -92,6 +92,8 @@ def human(spec: CheckedSpec, events: List[Event], end: float, out: TextIO) -> No
                     out.write(f"{'':14}@{label}: {', '.join(values)}\n")
                 if witness.rules:
                     out.write(f"{'':14}true: {', '.join(witness.rules)}\n")
+                if witness.false_rules:  # read under `not`: their being false is the cause
+                    out.write(f"{'':14}false: {', '.join(witness.false_rules)}\n")
                 for reading in witness.readings:
                     out.write(f"{'':14}{reading.text()}\n")
         elif e.kind == "release":

@@ -255,7 +255,8 @@ def _bags(ev: Evidence) -> str:
             w = getattr(e, "witness", None)
             why = ""
             if w is not None:
-                why = ("true: " + ", ".join(f"<code>{_e(k)}</code>" for k in w.rules) + "<br>" if w.rules else "") + \
+                why = "".join(f"{what}: " + ", ".join(f"<code>{_e(k)}</code>" for k in keys) + "<br>"
+                              for what, keys in (("true", w.rules), ("false", w.false_rules)) if keys) + \
                     "<br>".join(f"<span class='w'>{_e(r.text())}</span>" for r in w.readings)
             rows.append(f"<tr><td>{e.time:.3f} s</td><td>{_e(e.kind)}</td><td>{_e(labels.get(e.behaviour, ''))}</td>"
                         f"<td>{_attr(ev.spec.behaviours[e.behaviour - 1], 'id')}</td><td>{_list(e.actions)}</td>"

@@ -4,7 +4,7 @@ import os
 import time
 
 from rubass.engine import Engine
-from rubass.engine.explain import label
+from rubass.engine.explain import Witness, label
 from rubass.lang import ast, check_text
 
 from conftest import ROOT
@@ -44,6 +44,24 @@ def test_start_carries_true_rules_and_field_values():
     assert w.rules == ("base.too_fast",)  # base.unused is false: not a cause
     assert w.values()["/odom.twist.twist.linear.x"] == 0.62
     assert "/odom.pose.pose.position.x" not in w.values()  # read only by a false rule: not a cause
+
+
+def test_a_rule_read_under_not_is_a_cause_when_false_with_the_values_it_reads():
+    """`if (not pos.in_cell)` started with no rule and no value (acceptance sweep): the rule's being
+    false is the cause; a double `not` reads it as it is."""
+    spec = check_text("action primitive stop, warn;\nentity e { rules:\n  p: topic /a.data > 0;\n"
+                      "  q: topic /b.data > 0;\n  n: not p;\n}\nif (not e.p) then { stop; }\n"
+                      "if (e.n and not not e.q) then { warn; }\n", os.path.join(ROOT, "x.rbs"), [LIB])
+    e = Engine(spec, 0.0)
+    e.evaluate_all(0.0)
+    e.on_message("/b", 0.1, {"data": 2.0})
+    starts = {ev.behaviour: ev.witness for ev in e.on_message("/a", 0.2, {"data": -1.0}) if ev.kind == "start"}
+    assert (starts[1].rules, starts[1].false_rules) == ((), ("e.p",))
+    assert starts[1].values() == {"/a.data": -1.0} and starts[1].as_json()["false_rules"] == ["e.p"]
+    assert starts[1].causes() == "false: e.p"
+    assert (set(starts[2].rules), starts[2].false_rules) == ({"e.n", "e.q"}, ("e.p",))
+    assert starts[2].values() == {"/b.data": 2.0, "/a.data": -1.0}
+    assert "false_rules" not in Witness(("e.q",), ()).as_json()  # the JSON of every other start is as it was
 
 
 def test_age_witness_has_its_unit_and_the_deadline_value():
