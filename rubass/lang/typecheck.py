@@ -13,7 +13,8 @@ from .fieldmodel import FieldModel
 from .grammar import FUNCTIONS, bad_index_message
 from .ops import BINARY, SCALAR_FUNCTIONS, UNARY, scalar_fn
 from .source import Span
-from .units import DIMENSIONLESS, ODD, TIME, UNITS, Dimension, dim_mul, dim_sqrt, dimension_name, unit_suggestion
+from .units import (DIMENSIONLESS, ODD, TIME, UNITS, Dimension, dim_mul, dim_sqrt, dimension_name, to_si,
+                    unit_suggestion)
 from .values import UNKNOWN
 
 Value = ast.LitValue
@@ -139,7 +140,7 @@ class ExprChecker(BuiltinChecks):
         if unit is None:
             self.error(e.span, f"unknown unit '{e.unit}'{unit_suggestion(e.unit)}")
             return ast.Lit(e.value, span=e.span), ANY
-        value = e.value * unit[0]
+        value = to_si(e.value, e.unit)
         if not math.isfinite(value):  # 1e308 km: the literal is finite, its value in SI units is not
             self.error(e.span, f"the number '{_written(e)}' is too large once converted to SI units (the largest is "
                                "about 1.8e308): a limit of infinity would never trip")

@@ -92,6 +92,30 @@ UNITS: Dict[str, Tuple[float, Dimension]] = {
 }
 
 
+def _rational(factor: float) -> Optional[Tuple[int, int]]:
+    """(n, d) with n / d == factor exactly, small, when there is one (not for deg's pi/180)."""
+    from fractions import Fraction
+
+    f = Fraction(factor).limit_denominator(10 ** 6)
+    return (f.numerator, f.denominator) if f.denominator > 1 and f.numerator / f.denominator == factor else None
+
+
+_RATIONAL = {u: r for u, (f, _) in UNITS.items() for r in [_rational(f)] if r is not None}
+
+
+def to_si(value: float, unit: str) -> float:
+    """`value` in `unit` (a key of UNITS) in SI units, as the decimal a person means where a division
+    gives it: 70 % is 0.7 (70 * 0.01 is 0.7000000000000001, and `cpu(node n) >= 70 %` would be false at
+    0.7), 36 km/h is 10 m/s."""
+    factor = UNITS[unit][0]
+    r = _RATIONAL.get(unit)
+    if r is not None:
+        exact = value * r[0] / r[1]
+        if math.isfinite(exact):
+            return exact
+    return value * factor
+
+
 def dimension_name(d: Dimension) -> str:
     """A readable name: 'time', 'speed', or a formula such as 'm^2'."""
     if d == COUNT:
@@ -117,7 +141,7 @@ def parse_quantity(text: str) -> Optional[Tuple[float, Dimension]]:
     unit = UNITS.get(m.group(2))
     if unit is None:
         return None
-    si = value * unit[0]
+    si = to_si(value, m.group(2))
     if not math.isfinite(si) or (si == 0.0 and value != 0.0):  # 1e308 h is no timeout; 1e-322 us no zero
         return None
     return si, unit[1]

@@ -22,3 +22,15 @@ def test_a_model_files_unit_typo_gets_a_suggestion_of_its_dimension(write):
     model, diags = load_model(path, SourceSet())
     text = "\n".join(d.message for d in diags)
     assert model is None and "'m/sec' is not an SI unit" in text and "did you mean 'm/s'?" in text, text
+
+
+def test_a_unit_that_divides_gives_the_decimal_meant():
+    """70 % was 70 * 0.01 = 0.7000000000000001, so `cpu(node n) >= 70 %` was false at exactly 0.7
+    (acceptance sweep); a factor 1/n (or 5/18 for km/h) is applied as a division."""
+    from rubass.lang import check_text
+    from rubass.lang.units import parse_quantity
+
+    c = check_text("const P = 70 %;\nconst V = 36 km/h;\nconst T = 70 ms;\nconst A = 30 deg;\n")
+    assert c.consts == {"P": 0.7, "V": 10.0, "T": 0.07, "A": 30 * 3.141592653589793 / 180}
+    assert parse_quantity("70 %") == (0.7, parse_quantity("1 %")[1])
+    assert parse_quantity("1e308 km/h")[0] == 1e308 / 3.6  # not an overflow of 1e308 * 5 on the way
