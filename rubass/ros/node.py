@@ -24,13 +24,22 @@ USAGE = ("usage: rosrun rubass monitor _spec:=SPEC.rbs [_actions:=LIBRARY.yaml] 
          + HELP + "Check a spec first with: rubass check SPEC.rbs --actions LIBRARY.yaml\n")
 
 
+_EARLY_SIGHUP = b"rubass: SIGHUP before the monitor started: nothing to reload yet (the spec is read when it starts)\n"
+
+
+def early_sighup(signum: int, frame: object) -> None:
+    """SIGHUP while the monitor waits for the master: said, nothing else (os.write: see main)."""
+    os.write(2, _EARLY_SIGHUP)
+
+
 def main(argv: Optional[List[str]] = None) -> int:
     if wants_help(argv):
         sys.stdout.write(USAGE)
         return 0
-    # SIGHUP reloads once the monitor runs (its handler replaces this one); before, its default would end it
-    signal.signal(signal.SIGHUP, lambda signum, frame: sys.stderr.write(
-        "rubass: SIGHUP before the monitor started: nothing to reload yet (the spec is read when it starts)\n"))
+    # SIGHUP reloads once the monitor runs (its handler replaces this one); before, its default would end it.
+    # os.write, not sys.stderr: a signal that lands inside a write to sys.stderr (the "waiting for the
+    # ROS master" line) would make that write reentrant, a RuntimeError that ended the process
+    signal.signal(signal.SIGHUP, early_sighup)
     code = init_node("rubass", argv, lambda text: sys.stderr.write(f"rubass: {text}\n"))
     if code is not None:
         return code  # Monitor handles SIGINT/SIGTERM once it runs; before, a signal ends the wait for the master

@@ -91,3 +91,20 @@ def test_ctrl_c_during_the_imports_exits_130_without_a_traceback(tmp_path, scrip
         if proc.poll() is None:
             proc.kill()
             proc.wait()
+
+
+
+def test_a_sighup_that_lands_inside_a_write_to_stderr_does_not_end_the_process():
+    """The early SIGHUP handler wrote with sys.stderr, so one that landed inside another write to it (the
+    "waiting for the ROS master" line) was a reentrant call: RuntimeError, the monitor gone (seen 1 run in
+    6 on a fresh Debian 12). Here the signal is raised from inside that write, where it ran then."""
+    code = ("import io, os, signal, sys\nfrom rubass.ros.node import early_sighup\n"
+            "class Raw(io.RawIOBase):\n    def writable(self):\n        return True\n"
+            "    def write(self, b):\n        os.kill(os.getpid(), signal.SIGHUP)  # the buffered writer holds its lock\n"
+            "        return len(b)  # the handler runs at this line\n"
+            "sys.stderr = io.TextIOWrapper(io.BufferedWriter(Raw()), line_buffering=True)\n"
+            "signal.signal(signal.SIGHUP, early_sighup)\n"
+            "sys.stderr.write('rubass: waiting for the ROS master\\n')\nprint('alive')\n")
+    out = subprocess.run([sys.executable, "-c", code], cwd=ROOT, capture_output=True, text=True, timeout=30)
+    assert (out.returncode, out.stdout) == (0, "alive\n"), out.stderr
+    assert "SIGHUP before the monitor started" in out.stderr  # said on the real stderr, by os.write
