@@ -57,9 +57,16 @@ def test_a_refused_nice_is_a_warning_and_the_monitor_still_enforces(ros):
         os.mkdir(os.path.join(home, "log"))  # rospy's own would be chowned to the folder's owner, root, and fail:
         os.chown(os.path.join(home, "log"), nobody.pw_uid, nobody.pw_gid)  # its log lines then go nowhere
         path = spec(pathlib.Path(home), SPEC)
+        # the code too: a checkout in root's home (a fresh machine's /root/…) is no place nobody may read
+        shutil.copytree(os.path.join(ROOT, "rubass"), os.path.join(home, "rubass"),
+                        ignore=shutil.ignore_patterns("__pycache__"))
+        os.mkdir(os.path.join(home, "scripts"))
+        shutil.copy(os.path.join(ROOT, "scripts", "monitor"), os.path.join(home, "scripts", "monitor"))
         env = dict(ros.env, ROS_HOME=home, ROS_LOG_DIR=os.path.join(home, "log"), HOME=home)
+        env["PYTHONPATH"] = os.pathsep.join([home] + [p for p in env.get("PYTHONPATH", "").split(os.pathsep)
+                                                      if p and os.path.realpath(p) != os.path.realpath(ROOT)])
         mon = ros.spawn(["setpriv", "--reuid=nobody", "--regid=nogroup", "--clear-groups", "--inh-caps=-all",
-                         PY, os.path.join(ROOT, "scripts", "monitor"), "__name:=rubass", f"_spec:={path}",
+                         PY, os.path.join(home, "scripts", "monitor"), "__name:=rubass", f"_spec:={path}",
                          "_nice:=-5", f"_state_file:={os.path.join(home, 'latches.json')}"], "monitor-nobody", env=env)
         ros.wait_service("/rubass/reset", mon)
         values = monitor_values(ros)
