@@ -72,8 +72,8 @@ class Dispatcher:
         latency: Optional[float]
         if isinstance(cause, Message) and cause.received:
             source, latency = f"message on {cause.topic}", time.time() - cause.received
-        elif isinstance(cause, NodeSample):
-            source, latency = f"node sample of {cause.node}", None
+        elif isinstance(cause, NodeSample):  # from the sample's instant, or the deadline it came with
+            source, latency = f"node sample of {cause.node}", max(0.0, self.ros_now() - e.time)
         elif cause == "reset":
             source, latency = "reset service", None
         elif cause in ("reload", "shutdown"):
