@@ -16,7 +16,7 @@ import rospy
 
 from . import rpc
 
-TIMEOUT = 0.5  # seconds for each call to the master or a subscriber
+BUDGET = 0.5  # seconds for all the calls of one explanation (the runner's periodic output waits for it)
 KEEP = 5.0  # seconds an answer is reused
 MAX_NODES = 5  # subscribers asked for their type
 
@@ -28,13 +28,15 @@ def _subscribers(caller: rpc.Caller, me: str, topic: str) -> List[str]:
     return [n for name, nodes in state[1] if name == topic for n in nodes if n != me]
 
 
-def _subscribed_type(caller: rpc.Caller, me: str, node: str, topic: str) -> Optional[str]:
-    """The type `node` subscribes to `topic` with (None when it cannot be asked)."""
+def _subscribed_type(master_uri: str, me: str, node: str, topic: str, end: float) -> Optional[str]:
+    """The type `node` subscribes to `topic` with (None when it cannot be asked before `end`)."""
     try:
-        code, _, uri = caller.call("lookupNode", me, node)
-        if code != 1:
+        code, _, uri = rpc.Caller(master_uri, max(0.01, end - time.monotonic()), keep_alive=False).call(
+            "lookupNode", me, node)
+        if code != 1 or time.monotonic() >= end:
             return None
-        code, _, subs = rpc.Caller(uri, TIMEOUT, keep_alive=False).call("getSubscriptions", me)
+        code, _, subs = rpc.Caller(uri, max(0.01, end - time.monotonic()), keep_alive=False).call(
+            "getSubscriptions", me)
     except (OSError, xmlrpc.client.Error, ValueError):
         return None
     return dict((t, ty) for t, ty in subs).get(topic) if code == 1 else None
@@ -42,15 +44,15 @@ def _subscribed_type(caller: rpc.Caller, me: str, node: str, topic: str) -> Opti
 
 def explain(topic: str, published: str) -> str:
     """The reason a message of type `published` on `topic` reached no subscriber, as a sentence."""
-    resolved, me = rospy.resolve_name(topic), rospy.get_name()
+    resolved, me, uri = rospy.resolve_name(topic), rospy.get_name(), rosgraph.get_master_uri()
+    end = time.monotonic() + BUDGET
     try:
-        caller = rpc.Caller(rosgraph.get_master_uri(), TIMEOUT, keep_alive=False)
-        nodes = _subscribers(caller, me, resolved)
+        nodes = _subscribers(rpc.Caller(uri, BUDGET, keep_alive=False), me, resolved)
     except (OSError, xmlrpc.client.Error, ValueError):
-        return f"no node subscribes to {topic} that is connected (the master did not answer to say more)"
+        return f"no subscriber of {topic} is connected (the master did not answer to say more)"
     if not nodes:
         return f"no node subscribes to {topic}"
-    types: Dict[str, Optional[str]] = {n: _subscribed_type(caller, me, n, resolved) for n in nodes[:MAX_NODES]}
+    types: Dict[str, Optional[str]] = {n: _subscribed_type(uri, me, n, resolved, end) for n in nodes[:MAX_NODES]}
     other = {n: t for n, t in types.items() if t not in (None, published, "*")}
     if other:
         said = ", ".join(f"{n} as {t}" for n, t in sorted(other.items()))
