@@ -71,7 +71,7 @@ class _Checker:
                     self.error(d.name.span, f"duplicate name '{d.name.name}' ({a_noun(kind)}); first defined at "
                                             f"{top[d.name.name]}")
                     first = self.consts.get(d.name.name) or self.entities.get(d.name.name)
-                    if first is not None and type(first) is type(d):
+                    if first is not None:  # (a behaviour's name is checked with its behaviour)
                         self.duplicates.append((d, first))
                     continue
                 top[d.name.name] = d.name.span
