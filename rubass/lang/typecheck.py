@@ -13,7 +13,7 @@ from .fieldmodel import FieldModel
 from .grammar import FUNCTIONS, bad_index_message
 from .ops import BINARY, SCALAR_FUNCTIONS, UNARY, scalar_fn
 from .source import Span
-from .units import (DIMENSIONLESS, ODD, TIME, UNITS, Dimension, dim_mul, dim_sqrt, dimension_name, to_si,
+from .units import (DIMENSIONLESS, TIME, UNITS, Dimension, dim_mul, dim_sqrt, dimension_name, to_si,
                     unit_suggestion)
 from .values import UNKNOWN
 
@@ -415,8 +415,7 @@ class ExprChecker(BuiltinChecks):
             self._same_dim(result, t, e.span, f"{e.func}() mixes {{}} and {{}}")
             result = _join(result, t)
         if e.func == "sqrt" and result.dim is not None:
-            d = dim_sqrt(result.dim)
-            result = Ty("num", d if d is not None else ODD, result.bare)
+            result = Ty("num", dim_sqrt(result.dim), result.bare)
         return _fold(ast.Call(e.func, tuple(args), e.span)), result
 
     # -- helpers -------------------------------------------------------------------------

@@ -2,36 +2,41 @@
 from __future__ import annotations
 
 import math
-
-from typing import Dict, Optional, Tuple
+from fractions import Fraction
+from typing import Dict, Optional, Tuple, Union
 
 from .errors import a_noun
 
 # A dimension is a sorted tuple of (base, exponent); bases: m, s, rad, B, and V (voltage),
 # A (current), degC (temperature), Pa (pressure), geo_deg (latitude/longitude, see GEO_DEGREE).
-Dimension = Tuple[Tuple[str, int], ...]
+# An exponent is a whole number, or a Fraction where sqrt() halved an odd one (sqrt(1 m) is m^(1/2):
+# no SI dimension, but sqrt(2 m) * sqrt(1 m/s^2) is a speed again).
+Exponent = Union[int, Fraction]
+Dimension = Tuple[Tuple[str, Exponent], ...]
 
 DIMENSIONLESS: Dimension = ()
 
 
-def dim(**exps: int) -> Dimension:
+def _whole(exp: Exponent) -> Exponent:
+    return int(exp) if isinstance(exp, Fraction) and exp.denominator == 1 else exp
+
+
+def dim(**exps: Exponent) -> Dimension:
     """Build a dimension from base exponents, e.g. dim(m=1, s=-1)."""
-    return tuple(sorted((k, v) for k, v in exps.items() if v))
+    return tuple(sorted((k, _whole(v)) for k, v in exps.items() if v))
 
 
 def dim_mul(a: Dimension, b: Dimension, sign: int = 1) -> Dimension:
     """The dimension of a*b (sign=1) or a/b (sign=-1)."""
-    out: Dict[str, int] = dict(a)
+    out: Dict[str, Exponent] = dict(a)
     for base, exp in b:
         out[base] = out.get(base, 0) + sign * exp
     return dim(**out)
 
 
-def dim_sqrt(a: Dimension) -> Optional[Dimension]:
-    """The dimension of sqrt(a), or None when an exponent is odd."""
-    if any(exp % 2 for _, exp in a):
-        return None
-    return tuple((base, exp // 2) for base, exp in a)
+def dim_sqrt(a: Dimension) -> Dimension:
+    """The dimension of sqrt(a): every exponent halved."""
+    return dim(**{base: Fraction(exp) / 2 for base, exp in a})
 
 
 TIME = dim(s=1)
@@ -41,8 +46,6 @@ FREQUENCY = dim(s=-1)
 MEMORY = dim(B=1)
 # what count() and len() give: a number of things, compared with plain numbers only
 COUNT: Dimension = (("count", 1),)
-# the dimension of sqrt of an odd power (sqrt(1 m), sqrt(age(…))): no SI dimension matches it
-ODD: Dimension = (("sqrt of an odd power", 1),)
 VOLTAGE = dim(V=1)
 CURRENT = dim(A=1)
 TEMPERATURE = dim(degC=1)  # Celsius only: no kelvin, so no offset to convert
@@ -122,7 +125,8 @@ def dimension_name(d: Dimension) -> str:
         return "count"
     if d in _NAMES:
         return _NAMES[d]
-    return "*".join(base if exp == 1 else f"{base}^{exp}" for base, exp in d)
+    return "*".join(base if exp == 1 else f"{base}^({exp})" if isinstance(exp, Fraction) else f"{base}^{exp}"
+                    for base, exp in d)
 
 
 def parse_quantity(text: str) -> Optional[Tuple[float, Dimension]]:

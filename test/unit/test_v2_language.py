@@ -106,9 +106,14 @@ CASES = [
     ("a behaviour named like an action", HEAD + "entity e { rules: r: topic /v.x > 1; }\n"
      "warn: if (e.r) then { stop; }\n", (4, 1, "behaviour name 'warn' is also the name of a declared action")),
     ("sqrt of an odd power has no SI dimension", HEAD + "entity e { rules: r: sqrt(1 m) > 1 m; }\n"
-     "if (e.r) then { stop; }\n", (3, 32, "compares a sqrt of an odd power with a length")),
+     "if (e.r) then { stop; }\n", (3, 32, "compares a quantity in m^(1/2) with a length")),
     ("sqrt of a time compared with a time", HEAD + "entity e { rules: r: sqrt(age(topic /t)) > 1 s; }\n"
-     "if (e.r) then { stop; }\n", (3, 42, "compares a sqrt of an odd power with a time")),
+     "if (e.r) then { stop; }\n", (3, 42, "compares a quantity in s^(1/2) with a time")),
+    # half powers are kept apart (an acceptance sweep: they were one catch-all dimension)
+    ("sqrt of a time compared with sqrt of a length", HEAD + "entity e { rules: r: sqrt(age(topic /t)) > "
+     "sqrt(1 m); }\nif (e.r) then { stop; }\n", (3, 42, "compares a quantity in s^(1/2) with a quantity in m^(1/2)")),
+    ("sqrt of a length plus sqrt of a time", HEAD + "entity e { rules: r: sqrt(1 m) + sqrt(1 s) > 0; }\n"
+     "if (e.r) then { stop; }\n", (3, 32, "cannot add or subtract a quantity in m^(1/2) and a quantity in s^(1/2)")),
 ]
 
 
@@ -270,3 +275,10 @@ def test_a_behaviours_line_is_its_if_or_name_not_its_first_attribute(tmp_path):
                                '@id("B-3") if (\n  e.r) then { warn; }\n'
                                "if (e.r) then { stop; }\n")
     assert [b.span.line for b in spec.behaviours] == [6, 8, 9, 11]
+
+
+def test_half_powers_that_make_a_whole_dimension_again_are_accepted(tmp_path):
+    """`sqrt(2 m) * sqrt(1 m/s^2)` is a speed: it was refused ("a quantity in sqrt of an odd power^2")."""
+    c = ok(tmp_path, HEAD + "entity e { rules:\n  a: sqrt(2 m) * sqrt(1 m/s^2) > 1 m/s;\n"
+                            "  b: sqrt(age(topic /t)) * sqrt(age(topic /t)) > 2 s;\n}\nif (e.a or e.b) then { stop; }\n")
+    assert [r.key for r in c.rules] == ["e.a", "e.b"]
