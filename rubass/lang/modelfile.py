@@ -129,11 +129,16 @@ def parse_model(src: Source) -> Tuple[Optional[SystemModel], List[Diagnostic]]:
             topics[name] = ty
     nodes: Optional[List[str]] = None
     if "nodes" in entries:
-        value = _plain(entries["nodes"][1])
+        node_list = entries["nodes"][1]
+        value = _plain(node_list)
         if not isinstance(value, list) or not all(isinstance(n, str) for n in value):
-            r.error(entries["nodes"][1], "'nodes' must be a list of node names")
+            r.error(node_list, "'nodes' must be a list of node names")
         else:
-            nodes = value
+            bad = [(i, n) for i, n in enumerate(value) if not TOPIC_RE.fullmatch(n)]  # graph names, as topics
+            for i, n in bad:
+                r.error(node_list.value[i] if isinstance(node_list, yaml.SequenceNode) else node_list,
+                        f"'{n}' is not a node name")
+            nodes = [n for n in value if TOPIC_RE.fullmatch(n)]
     units = {}
     for ty, knode, vnode in r.mapping(entries["units"][1], "'units'") if "units" in entries else []:
         if TYPE_RE.fullmatch(ty) is None:

@@ -202,6 +202,7 @@ def test_hand_written_model_file():
     ("topics:\n  /a: !foo x\n", "robot.yaml:2:7", "YAML tag '!foo' is not allowed"),
     ("topics: !!python/object:os.system {}\n", "robot.yaml:1:9", "is not allowed: a system model holds plain data"),
     ("topics:\n  3: a/B\n", "robot.yaml:2:3", "'3' is not a topic name"),
+    ("topics: {}\nnodes: [/driver, bad name!]\n", "robot.yaml:2:18", "'bad name!' is not a node name"),  # sweep
     ("\x00", "robot.yaml:1:1", "invalid YAML"),
 ])
 def test_model_file_errors_point_at_the_line(text, where, msg):
