@@ -50,7 +50,7 @@ def definition_problems(type_name: str, text: str, defined: Iterable[str]) -> Li
                 and not ftype[:1].isupper():
             hint = did_you_mean(ftype, sorted(PRIMITIVES) + own + ["Header"])
             out.append((number, f"{type_name}: line {number}: unknown field type '{ftype}'{hint} (a primitive such "
-                                f"as float64, a message type of {package} written 'Type', or 'package/Type')"))
+                                f"as float64, a message of package {package} written 'Type', or 'package/Type')"))
         if name in seen:
             out.append((number, f"{type_name}: line {number}: field '{name}' is named twice (first on line "
                                 f"{seen[name]})"))

@@ -158,6 +158,7 @@ def parse_model(src: Source) -> Tuple[Optional[SystemModel], List[Diagnostic]]:
         except DefinitionError as exc:
             problems = problems or [(exc.line, str(exc))]
         for line, why in problems:
+            why = why[len(ty) + 2:] if why.startswith(f"{ty}: ") else why  # "the definition of a/B: a/B: …"
             place = _definition_line(src, vnode, line)
             if place is None:
                 r.error(vnode, f"the definition of {ty}: {why}")

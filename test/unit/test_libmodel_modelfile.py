@@ -43,10 +43,10 @@ def test_units_of_a_field_the_definition_lacks_are_errors_at_the_field(units, ex
 
 @pytest.mark.parametrize("definition,expected", [
     ("    float64 x\n    flaot32 bad\n",
-     "5:5: the definition of a_msgs/B: a_msgs/B: line 2: unknown field type 'flaot32'; did you mean 'float32'? "
-     "(a primitive such as float64, a message type of a_msgs written 'Type', or 'package/Type')"),
+     "5:5: the definition of a_msgs/B: line 2: unknown field type 'flaot32'; did you mean 'float32'? "
+     "(a primitive such as float64, a message of package a_msgs written 'Type', or 'package/Type')"),
     ("    float64 x\n\n    # c\n    uint8 x\n",
-     "7:5: the definition of a_msgs/B: a_msgs/B: line 4: field 'x' is named twice (first on line 1)"),
+     "7:5: the definition of a_msgs/B: line 4: field 'x' is named twice (first on line 1)"),
 ])
 def test_definition_problems_are_errors_at_their_line(definition, expected):
     assert problems("topics: {}\ndefinitions:\n  a_msgs/B: |\n" + definition) == [expected]
@@ -55,7 +55,7 @@ def test_definition_problems_are_errors_at_their_line(definition, expected):
 def test_every_definition_problem_at_once_and_types_that_may_be_installed_are_accepted():
     found = problems("topics: {}\ndefinitions:\n  a_msgs/B: |\n    flaot32 a\n    C c\n    Header h\n"
                      "    geometry_msgs/Twist t\n    Vector3 v\n    C[] a\n  a_msgs/C: |\n    strin s\n")
-    assert [f.split(": a_msgs/")[0] for f in found] == [
+    assert [f.split(": line ")[0] for f in found] == [
         "4:5: the definition of a_msgs/B", "9:5: the definition of a_msgs/B", "11:5: the definition of a_msgs/C"]
     assert "field 'a' is named twice" in found[1] and "did you mean 'string'?" in found[2]
 
