@@ -125,8 +125,9 @@ def dimension_name(d: Dimension) -> str:
         return "count"
     if d in _NAMES:
         return _NAMES[d]
-    return "*".join(base if exp == 1 else f"{base}^({exp})" if isinstance(exp, Fraction) else f"{base}^{exp}"
-                    for base, exp in d)
+    shown = {"geo_deg": "deg(lat/lon)"}  # a base of its own (GEO_DEGREE), not a unit a spec writes
+    return "*".join(f"{shown.get(base, base)}" + ("" if exp == 1 else f"^({exp})" if isinstance(exp, Fraction)
+                                                  else f"^{exp}") for base, exp in d)
 
 
 def parse_quantity(text: str) -> Optional[Tuple[float, Dimension]]:

@@ -34,3 +34,10 @@ def test_a_unit_that_divides_gives_the_decimal_meant():
     assert c.consts == {"P": 0.7, "V": 10.0, "T": 0.07, "A": 30 * 3.141592653589793 / 180}
     assert parse_quantity("70 %") == (0.7, parse_quantity("1 %")[1])
     assert parse_quantity("1e308 km/h")[0] == 1e308 / 3.6  # not an overflow of 1e308 * 5 on the way
+
+
+def test_a_formula_of_dimensions_names_no_internal_base():
+    """'a quantity in geo_deg*s^-1' showed the checker's own name for NavSatFix degrees (acceptance sweep)."""
+    from rubass.lang.units import dim, dimension_name
+
+    assert dimension_name(dim(geo_deg=1, s=-1)) == "deg(lat/lon)*s^-1"
