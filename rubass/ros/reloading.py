@@ -189,9 +189,9 @@ class Reloading:
         watcher = getattr(self, "watcher", None)  # none before the first spec is enforced
         types = watcher.carried_types() if watcher is not None else {}
         errors = live_errors(spec, self.config.actions, types) if types else []
-        if errors:
-            raise StartupError("the new spec does not fit the message types its topics carry now (as "
-                               "`rubass check --live` reads them):\n" + "\n".join(errors))
+        if errors:  # the first line is the first error itself: it is what /diagnostics shows of a rejection
+            raise StartupError("\n".join(errors) + "\n(the new spec does not fit the message types its topics "
+                               "carry now, as `rubass check --live` reads them)")
 
     def _load_stable(self) -> CheckedSpec:
         """load_spec, again if a file changed while it was read or within the last 50 ms (an

@@ -28,6 +28,11 @@ def test_a_reload_with_a_field_the_live_type_lacks_is_rejected_and_the_active_br
     assert "does not fit the message types its topics carry now" in log, log
     assert "s.rbs:3:28: error: 'linear' (geometry_msgs/Vector3) has no field 'xx'; did you mean 'x'?" in log, log
     assert len(_brakes(ros, 1.0)) >= 10, ros.log(mon)  # 20 Hz: still braking, not released
+    rec = ros.probe({"listen": [{"topic": "/diagnostics", "type": "diagnostic_msgs/DiagnosticArray"}],
+                     "steps": [{"sleep": 2.5}]})
+    shown = [v["value"] for r in rec if r["kind"] == "recv" for st in r["msg"]["status"]
+             if st["name"] == "rubass: monitor" for v in st["values"] if v["key"] == "last reload error"]
+    assert shown and "has no field 'xx'" in shown[-1], shown  # the error itself, not a heading
 
     spec(tmp_path, BODY.format(field="x") + "if (base.fast) then { warn; }\n")
     assert "true" in ros.call("/rubass/reload").stdout.lower(), ros.log(mon)  # a spec that fits is taken
