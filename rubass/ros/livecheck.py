@@ -56,6 +56,7 @@ class LiveTypeCheck:
         self._types: Types = {}
         self._said: set = set()  # errors logged for this spec
         self._version = 0  # bumped by every change; a check of an older one is not kept
+        self._known: Optional[Tuple[CheckedSpec, Types, List[str]]] = None  # a result found elsewhere
         self._closed = False
         threading.Thread(target=self._run, name="rubass-livecheck", daemon=True).start()
 
@@ -67,6 +68,12 @@ class LiveTypeCheck:
             self._spec, self._libraries, self._said, self.errors = spec, list(libraries), set(), []
             self._version += 1
         self._wake.set()
+
+    def known(self, spec: CheckedSpec, types: Types, errors: List[str]) -> None:
+        """What live_errors gave for `spec` with `types` (a reload checked it before its swap): the
+        thread takes it rather than checking the same spec against the same types again."""
+        with self._lock:
+            self._known = (spec, dict(types), list(errors))
 
     def note(self, types: Types) -> None:
         """The types the spec's topics carry now (cheap when nothing changed: call it freely)."""
@@ -91,8 +98,10 @@ class LiveTypeCheck:
                 spec, libraries, types, version = self._spec, self._libraries, dict(self._types), self._version
             if spec is None or not types:
                 continue
+            known = self._known
             try:
-                errors = live_errors(spec, libraries, types)
+                errors = known[2] if known is not None and known[0] is spec and known[1] == types else \
+                    live_errors(spec, libraries, types)
             except Exception as exc:  # noqa: BLE001 - a bug here must not end the thread, nor hide itself
                 self.log("error", f"rubass: checking the spec against the live message types failed: "
                                   f"{exc.__class__.__name__}: {exc}")

@@ -189,6 +189,9 @@ class Reloading:
         watcher = getattr(self, "watcher", None)  # none before the first spec is enforced
         types = watcher.carried_types() if watcher is not None else {}
         errors = live_errors(spec, self.config.actions, types) if types else []
+        livecheck = getattr(self, "livecheck", None)
+        if livecheck is not None and types:
+            livecheck.known(spec, types, errors)  # its thread need not check the new spec against these again
         if errors:  # the first line is the first error itself: it is what /diagnostics shows of a rejection
             raise StartupError("\n".join(errors) + "\n(the new spec does not fit the message types its topics "
                                "carry now, as `rubass check --live` reads them)")

@@ -67,3 +67,25 @@ def test_the_check_logs_each_error_once_per_spec_and_a_fixed_spec_clears_it(writ
         assert _wait(lambda: len(logged) == 2)
     finally:
         check.close()
+
+
+def test_a_result_found_at_a_reload_is_not_computed_again_for_the_same_types(write, monkeypatch):
+    """A reload checks the new spec against the carried types before its swap; the check's thread then
+    takes that result for the same spec and types instead of a second check of the whole spec."""
+    import rubass.ros.livecheck as livecheck
+
+    calls = []
+    real = livecheck.live_errors
+    monkeypatch.setattr(livecheck, "live_errors", lambda *a: calls.append(1) or real(*a))
+    check = LiveTypeCheck(lambda level, text: None)
+    try:
+        right = _spec(write, RIGHT)
+        check.known(right, {"/cmd_vel": TWIST}, [])
+        check.use(right, [])
+        check.note({"/cmd_vel": TWIST})
+        time.sleep(0.3)
+        assert calls == [] and check.errors == []
+        check.note({"/cmd_vel": TWIST, "/x": TWIST})  # other types: checked
+        assert _wait(lambda: calls == [1])
+    finally:
+        check.close()
