@@ -1,7 +1,6 @@
 """What the simulated nodes share: reading faults, publishing odometry."""
 from __future__ import annotations
 
-import gc
 import json
 import math
 from typing import Any, Callable, Dict
@@ -41,9 +40,10 @@ def freeze_heap() -> None:
     """Keep full garbage collections out of a simulated node's timing. A rospy node holds ~43,000
     objects; a full collection of them took 11-14 ms here and held the GIL, so a stop arriving then
     reached the simulated base that much later and counted in the monitor's (b), while a real base
-    driver is C++. The set-up is frozen out of the collector's scans (as the monitor does, gcfreeze.py)."""
-    gc.collect()
-    gc.freeze()
+    driver is C++. The set-up is frozen out of the collector's scans, as the monitor's is."""
+    from rubass.ros.gcfreeze import freeze_heap as freeze
+
+    freeze()
 
 
 def as_hardware() -> None:
