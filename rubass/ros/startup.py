@@ -81,7 +81,7 @@ def init_node(name: str, argv: Optional[List[str]], say: Callable[[str], None]) 
     previous = {s: signal.signal(s, stop) for s in (signal.SIGINT, signal.SIGTERM)}
     failed = ""
     try:
-        _wait_for_master(uri, say)  # rospy waits only if no _param:= is given; with one it raises at once
+        _wait_for_master(uri, say, stopped)  # rospy waits only if no _param:= is given; with one it raises at once
         rospy.init_node(name, argv=argv, disable_signals=True)
     except _Stopped:
         pass
@@ -107,13 +107,18 @@ def init_node(name: str, argv: Optional[List[str]], say: Callable[[str], None]) 
     return code
 
 
-def _wait_for_master(uri: str, say: Callable[[str], None]) -> None:
-    """Until the master at `uri` answers (a signal ends the wait: the handler raises)."""
+def _wait_for_master(uri: str, say: Callable[[str], None], stopped: List[int]) -> None:
+    """Until the master at `uri` answers or a signal ends the wait (its handler raises, and records it in
+    `stopped`: rosgraph's is_master_online swallows any exception with a bare `except`, so a signal that
+    lands inside it is seen only in `stopped`; the wait went on for good)."""
     import rosgraph
 
     said = False
-    while not rosgraph.is_master_online(uri):
+    while not stopped and not rosgraph.is_master_online(uri):
         if not said:
             say(f"waiting for the ROS master at {uri} (is roscore running? is ROS_MASTER_URI right?)")
             said = True
-        time.sleep(0.5)
+        if not stopped:
+            time.sleep(0.5)
+    if stopped:
+        raise _Stopped(stopped[0])

@@ -97,3 +97,28 @@ def test_a_sighup_while_waiting_for_the_master_does_not_end_the_monitor(tmp_path
             os.killpg(proc.pid, signal.SIGKILL)
             proc.wait()
     assert proc.returncode == 0 and "nothing to reload yet" in err and "Traceback" not in err, err
+
+
+def test_a_signal_that_lands_inside_the_master_check_still_ends_the_wait():
+    """rosgraph's is_master_online swallows every exception with a bare `except`, the _Stopped the
+    SIGTERM handler raised too: a SIGTERM that landed inside it (not in the sleep between two checks)
+    was lost and the wait went on for good (a CI run: no exit 15 s after the signal). Here the signal
+    is raised from inside that check, as it ran then; the process must say so and exit 0 at once."""
+    code = ("import os, signal, sys, time\nimport rosgraph\nfrom rubass.ros.startup import init_node\n"
+            "def online(uri=None):\n    try:\n        os.kill(os.getpid(), signal.SIGTERM)\n"
+            "        time.sleep(0.01)  # the handler runs here and raises; rosgraph swallows it\n"
+            "    except:  # noqa: E722 - as rosgraph.masterapi.Master.is_online does\n        return False\n"
+            "    return False\n"
+            "rosgraph.is_master_online = online\n"
+            "sys.exit(init_node('probe', ['probe'], lambda t: sys.stderr.write(t + '\\n')))\n")
+    env = dict(os.environ, ROS_MASTER_URI="http://127.0.0.1:1", PYTHONDONTWRITEBYTECODE="1")
+    started = time.monotonic()
+    try:
+        out = subprocess.run([sys.executable, "-c", code], cwd=ROOT, env=env, capture_output=True, text=True,
+                             timeout=15)
+    except subprocess.TimeoutExpired:
+        pytest.fail("the wait for the master went on after a SIGTERM that landed inside the master check")
+    assert out.returncode == 0, out.stderr
+    assert time.monotonic() - started < 10.0
+    assert "stopped before the ROS master at http://127.0.0.1:1 answered" in out.stderr, out.stderr
+    assert "Traceback" not in out.stderr, out.stderr
