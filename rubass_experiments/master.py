@@ -9,6 +9,8 @@ import time
 import uuid
 from typing import Dict, List, Optional
 
+from rubass.ros.startup import master_answers
+
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))  # the checkout
 
 
@@ -32,15 +34,18 @@ class PrivateMaster:
                                         stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True)
         import rosgraph
 
-        end = time.time() + 10
-        while not rosgraph.is_master_online(self.uri):
-            if time.time() > end or self.process.poll() is not None:
-                self.stop()
-                raise RuntimeError(f"rosmaster did not start on port {self.port}")
-            time.sleep(0.05)
-        self.online_at = time.time()  # when it first answered
-        # roscore sets /run_id, and roslaunch waits for it; a bare rosmaster does not
-        rosgraph.Master("/rubass", master_uri=self.uri).setParam("/run_id", str(uuid.uuid1()))
+        try:
+            end = time.time() + 10
+            while not master_answers(self.uri):  # not rosgraph's: it swallows a Ctrl-C raised inside it
+                if time.time() > end or self.process.poll() is not None:
+                    raise RuntimeError(f"rosmaster did not start on port {self.port}")
+                time.sleep(0.05)
+            self.online_at = time.time()  # when it first answered
+            # roscore sets /run_id, and roslaunch waits for it; a bare rosmaster does not
+            rosgraph.Master("/rubass", master_uri=self.uri).setParam("/run_id", str(uuid.uuid1()))
+        except BaseException:  # a failed start, or a stop signal meanwhile: the caller never gets this master
+            self.stop()
+            raise
 
     def restart(self, down: float = 0.0) -> None:
         """Kill the master (SIGKILL, as a crash would), wait `down` seconds, start a new one on

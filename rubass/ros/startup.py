@@ -107,14 +107,23 @@ def init_node(name: str, argv: Optional[List[str]], say: Callable[[str], None]) 
     return code
 
 
-def _wait_for_master(uri: str, say: Callable[[str], None], stopped: List[int]) -> None:
-    """Until the master at `uri` answers or a signal ends the wait (its handler raises, and records it in
-    `stopped`: rosgraph's is_master_online swallows any exception with a bare `except`, so a signal that
-    lands inside it is seen only in `stopped`; the wait went on for good)."""
+def master_answers(uri: str) -> bool:
+    """Whether the master at `uri` answers: rosgraph.is_master_online without its bare `except`, which
+    swallowed the exception a stop signal's handler raised inside it (the signal was lost)."""
     import rosgraph
 
+    try:
+        rosgraph.Master("/rubass", master_uri=uri).getPid()
+    except Exception:  # noqa: BLE001 - refused, reset, a fault: not answering (a signal's BaseException passes)
+        return False
+    return True
+
+
+def _wait_for_master(uri: str, say: Callable[[str], None], stopped: List[int]) -> None:
+    """Until the master at `uri` answers or a signal ends the wait (its handler raises, and records it in
+    `stopped`, should any library code still swallow what it raised: the wait went on for good once)."""
     said = False
-    while not stopped and not rosgraph.is_master_online(uri):
+    while not stopped and not master_answers(uri):
         if not said:
             say(f"waiting for the ROS master at {uri} (is roscore running? is ROS_MASTER_URI right?)")
             said = True

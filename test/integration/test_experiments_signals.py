@@ -187,3 +187,28 @@ def test_children_die_when_the_runner_is_sigkilled(experiments):
     assert not left, f"left running after the runner was SIGKILLed: {left}"
     assert runner not in left
     _assert_bag_closed(e.bag(0))  # the recorder got SIGINT, not SIGKILL
+
+
+def test_a_ctrl_c_that_lands_inside_the_master_check_stops_the_command(tmp_path):
+    """rosgraph's is_master_online swallows every exception with a bare `except`: a Ctrl-C that landed
+    inside it while a row's master started raised Interrupted there and was lost (the Supervisor raises
+    once; a second Ctrl-C is ignored while stopping), so the experiments went on. Here the signal is
+    raised from inside the first master check; the runner's PrivateMaster must raise Interrupted and
+    leave no master running (the one it had started was left running when its start was cut short)."""
+    code = ("import os, signal, sys\nimport rosgraph.masterapi\n"
+            "from rubass_experiments.master import PrivateMaster\nfrom rubass_experiments.procs import Interrupted, Supervisor\n"
+            "import subprocess\nstarted = []\nPopen = subprocess.Popen\n"
+            "def popen(*a, **k):\n    started.append(Popen(*a, **k))\n    return started[-1]\n"
+            "subprocess.Popen = popen\n"
+            "real = rosgraph.masterapi.Master.getPid\nsent = []\n"
+            "def getpid(self):\n    if not sent:\n        sent.append(1)\n        os.kill(os.getpid(), signal.SIGINT)\n"
+            "    return real(self)\n"
+            "rosgraph.masterapi.Master.getPid = getpid\n"
+            "try:\n    with Supervisor():\n        m = PrivateMaster(sys.argv[1])\n"
+            "        print('started', m.process.pid, flush=True)\n        m.stop()\n"
+            "except Interrupted:\n    print('interrupted', flush=True)\n"
+            "print('left running:', [p.args for p in started if p.poll() is None], flush=True)\n")
+    out = subprocess.run([sys.executable, "-c", code, str(tmp_path / "home")], cwd=ROOT, capture_output=True,
+                         text=True, timeout=60)
+    assert out.stdout == "interrupted\nleft running: []\n", (out.stdout, out.stderr)
+    assert "Traceback" not in out.stderr, out.stderr
