@@ -232,7 +232,7 @@ def test_an_entity_renamed_keeps_the_for_of_rules_using_their_siblings(monkeypat
 
 
 def test_a_renamed_key_is_replaced_only_as_a_whole_name():
-    from rubass.engine.engine import _renamer
+    from rubass.engine.handover import _renamer
 
     rename = _renamer({"e.fast": "base.fast"})
     assert rename("e.fast for 0.5 [e.fast: topic /e.fast > 1]") == "base.fast for 0.5 [base.fast: topic /e.fast > 1]"
