@@ -7,7 +7,6 @@ from __future__ import annotations
 import contextlib
 import dataclasses
 import gc
-import os
 from typing import Any, Callable, Dict, FrozenSet, Iterator, List, Optional, Sequence, Set, Tuple
 
 from . import ast
@@ -15,11 +14,11 @@ from .errors import Diagnostic, a_noun, did_you_mean
 from .fieldmodel import FieldModel
 from .fmt import format_expr
 from .libcheck import argument_problem
-from .library import ActionDef, load_library
+from .library import ActionDef
+from .actiondecls import ActionDecls
 from .attributes import AttrChecker
 from .deporder import dependency_order
 from .model import BoundAction, CheckedBehaviour, CheckedRule, CheckedSpec, TopicUse, Value
-from .paths import PathError, resolve
 from .source import SourceSet, Span
 from .typecheck import ANY, ExprChecker, Resolution, Scope, Ty, _constant
 
@@ -27,7 +26,7 @@ STAMP_PATH: Tuple[ast.PathElem, ...] = ("header", "stamp")
 UNUSED_ACTION = "unused action "  # the subject of that warning, then the action's name
 
 
-class _Checker:
+class _Checker(ActionDecls):
     def __init__(self, spec: ast.Spec, sources: SourceSet, model: Optional[FieldModel] = None) -> None:
         self.spec, self.sources, self.model = spec, sources, model
         self.diags: List[Diagnostic] = []
@@ -225,79 +224,6 @@ class _Checker:
                                  lambda node: deps.get(node, ()), cycle)
         return [node for node in order if not node.startswith("active(")]
 
-    # -- actions -------------------------------------------------------------------------
-    def load_libraries(self, extra: Sequence[str]) -> Tuple[Dict[str, ActionDef], List[str]]:
-        actions: Dict[str, ActionDef] = {}
-        loaded: List[str] = []
-        base = os.path.dirname(os.path.abspath(self.spec.file))
-        wanted: List[Tuple[str, Span]] = []
-        for d in self.spec.decls:
-            if isinstance(d, ast.Import):
-                try:
-                    wanted.append((resolve(d.path, base), d.span))
-                except PathError as exc:
-                    self.error(d.span, f"cannot import '{d.path}': {exc}")
-        wanted += [(os.path.abspath(p), Span(p, 0, 0)) for p in extra]
-        for path, span in wanted:
-            if path in loaded:
-                continue
-            if span.line and not os.path.isfile(path):
-                why = ("it is a directory" if os.path.isdir(path) else
-                       "not a regular file" if os.path.exists(path) else "no such file")
-                self.error(span, f"cannot import '{path}': {why}")
-                continue
-            lib, diags = load_library(path, self.sources)
-            self.diags.extend(diags)
-            if not lib and any(d.severity == "error" and not d.subject for d in diags):
-                self._unusable_libraries.append(path)  # its own error says why; its actions are not "undefined"
-            if self.sources.get(path) is not None:  # read, even if some actions were invalid
-                loaded.append(path)
-            for name, act in lib.items():
-                if name in actions:
-                    self.error(act.span, f"action '{name}' is defined again; first defined at {actions[name].span}")
-                else:
-                    actions[name] = act
-        return actions, loaded
-
-    def check_actions(self, library: Dict[str, ActionDef], loaded: List[str]) -> Dict[str, Span]:
-        declared: Dict[str, Span] = {}
-        for d in self.spec.decls:
-            if not isinstance(d, ast.ActionDecl):
-                continue
-            for ident in d.names:
-                if ident.name in declared:
-                    self.error(ident.span, f"duplicate action '{ident.name}': already declared at "
-                                           f"{declared[ident.name]}")  # duplicate names are errors (§9)
-                    continue
-                declared[ident.name] = ident.span
-                if ident.name not in library and not self._broken_in_library(ident.name) \
-                        and not self._unusable_libraries:
-                    failed = self._failed_imports(loaded)
-                    where = ("no action library is loaded: add 'import \"actions.yaml\";' or pass --actions"
-                             if not loaded else "loaded: " + ", ".join(loaded))
-                    if failed:  # the spec has an import: say that it failed, not that there is none
-                        where = (f"{'its library' if len(failed) == 1 else 'its libraries'} "
-                                 f"{', '.join(repr(f) for f in failed)} could not be loaded: see the error above"
-                                 + (f"; loaded: {', '.join(loaded)}" if loaded else ""))
-                    self.error(ident.span, f"action '{ident.name}' is not defined in any action library "
-                                           f"({where}){did_you_mean(ident.name, library)}")
-        return declared
-
-    def _failed_imports(self, loaded: List[str]) -> List[str]:
-        """The spec's imports (as written) that could not be loaded: a package not found, no such file."""
-        base = os.path.dirname(os.path.abspath(self.spec.file))
-        out: List[str] = []
-        for d in self.spec.decls:
-            if not isinstance(d, ast.Import):
-                continue
-            try:
-                path: Optional[str] = resolve(d.path, base)
-            except PathError:
-                path = None
-            if path not in loaded and path not in self._unusable_libraries and d.path not in out:
-                out.append(d.path)
-        return out
-
     def _own_span(self, d: ast.Behaviour) -> Span:
         """A behaviour's span from its name or its `if`, after its attributes: its line is the one
         events, tests and reports give (docs/replay.md: 'the line of its if')."""
@@ -306,10 +232,6 @@ class _Checker:
             return d.span
         start = d.name.span.start if d.name is not None else src.text.rfind("if", d.span.start, d.cond.span.start)
         return src.span(start, d.span.end) if d.span.start <= start < d.span.end else d.span
-
-    def _broken_in_library(self, name: str) -> bool:
-        """True when a library defines `name` but its definition had errors (already reported)."""
-        return any(d.subject == name for d in self.diags)
 
     def check_behaviours(self, declared: Dict[str, Span], library: Dict[str, ActionDef]) -> List[CheckedBehaviour]:
         out: List[CheckedBehaviour] = []
