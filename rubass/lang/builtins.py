@@ -4,24 +4,14 @@ from __future__ import annotations
 
 import functools
 import math
-import sys
 from dataclasses import replace
 from typing import Any, FrozenSet, List, Tuple
 
 from . import ast
 from .errors import a_noun
+from .exprtypes import ANY, BOOL, QuantScope, Ty, describe, num
 from .geometry import polygon_problem
 from .units import COUNT, DIMENSIONLESS, FREQUENCY, LENGTH, MEMORY, TIME, dim_mul, dimension_name
-
-# Ty, BOOL, … live in typecheck, which imports this module: _types() finds it when a check runs
-# (an import statement in each method would cost more than the method's own work).
-_TYPECHECK = __name__.rsplit(".", 1)[0] + ".typecheck"
-
-
-def _types() -> Any:
-    """The typecheck module (always imported by then: only its ExprChecker runs these methods)."""
-    return sys.modules[_TYPECHECK]
-
 
 _TOPIC_FORMS = {"frequency": "frequency(topic /t) or frequency(topic /t, 2 s)", "age": "age(topic /t)",
                 "stamp_age": "stamp_age(topic /t)"}
@@ -44,7 +34,6 @@ class BuiltinChecks:
     quant: Any
 
     def _builtin(self, e: ast.Call) -> Tuple[ast.Expr, Any]:
-        ANY = _types().ANY
         f = e.func
         if f in ("frequency", "age", "stamp_age"):
             return self._topic_fn(e)
@@ -73,8 +62,6 @@ class BuiltinChecks:
             self.error(e.span, f"a constant cannot use {e.func}()")  # type: ignore[attr-defined]
 
     def _topic_fn(self, e: ast.Call) -> Tuple[ast.Expr, Any]:
-        tc = _types()
-        ANY, num = tc.ANY, tc.num
         args = list(e.args)
         self._dynamic_only(e)
         max_args = 2 if e.func == "frequency" else 1
@@ -108,8 +95,6 @@ class BuiltinChecks:
         return ast.Frequency(ref.topic, window, span=e.span), num(FREQUENCY)
 
     def _node_fn(self, e: ast.Call) -> Tuple[ast.Expr, Any]:
-        tc = _types()
-        ANY, BOOL, num = tc.ANY, tc.BOOL, tc.num
         self._dynamic_only(e)
         if len(e.args) != 1 or not isinstance(e.args[0], ast.NodeRef):
             self.error(e.span, f"{e.func}() is written {e.func}(node /name)")  # type: ignore[attr-defined]
@@ -130,8 +115,6 @@ class BuiltinChecks:
         return ast.NodeStat(ref.node, e.func, span=e.span), ty
 
     def _rate(self, e: ast.Call) -> Tuple[ast.Expr, Any]:
-        tc = _types()
-        ANY, num = tc.ANY, tc.num
         self._dynamic_only(e)
         if len(e.args) != 1 or not isinstance(e.args[0], ast.TopicRef) or not e.args[0].path:
             self.error(e.span, "rate() takes a topic field: rate(topic /odom.twist.twist.linear.x)")  # type: ignore[attr-defined]
@@ -142,8 +125,7 @@ class BuiltinChecks:
             return e, ANY
         _, fty = self.check(ref)  # type: ignore[attr-defined]
         if fty.kind not in ("num", "any"):
-            _describe = _types()._describe
-            self.error(ref.span, f"rate() needs a number, not a {_describe(fty)}")  # type: ignore[attr-defined]
+            self.error(ref.span, f"rate() needs a number, not a {describe(fty)}")  # type: ignore[attr-defined]
         dim = None if fty.kind != "num" or fty.dim is None else dim_mul(fty.dim, TIME, -1)
         return ast.Rate(ref, span=e.span), num(dim)
 
@@ -156,8 +138,6 @@ class BuiltinChecks:
         return replace(ref, path=ref.path[:i + 1]), ref.path[i + 1:]
 
     def _array_fn(self, e: ast.Call) -> Tuple[ast.Expr, Any]:
-        tc = _types()
-        ANY, num = tc.ANY, tc.num
         arg = e.args[0]
         if not isinstance(arg, ast.TopicRef) or not arg.path:
             what = "an array field such as 'topic /scan.ranges'" if e.func == "len" else \
@@ -185,8 +165,6 @@ class BuiltinChecks:
         return out, (num(COUNT) if e.func == "len" else num(ety.dim if ety.kind == "num" else None))
 
     def _quantifier(self, e: ast.Call) -> Tuple[ast.Expr, Any]:
-        tc = _types()
-        ANY, BOOL, _Quant, num = tc.ANY, tc.BOOL, tc._Quant, tc.num
         self._dynamic_only(e)
         if len(e.args) != 1:
             self.error(e.span, f"{e.func}() takes one condition over an array, e.g. "  # type: ignore[attr-defined]
@@ -195,7 +173,7 @@ class BuiltinChecks:
         if self.quant is not None:
             self.error(e.span, f"quantifiers cannot be nested: {e.func}() inside {self.quant.func}()")  # type: ignore[attr-defined]
             return e, ANY
-        self.quant = _Quant(e.func)
+        self.quant = QuantScope(e.func)
         try:
             body, ty = self.check(e.args[0])  # type: ignore[attr-defined]
             self._want_bool(ty, e.args[0].span, f"{e.func}()")  # type: ignore[attr-defined]
@@ -221,8 +199,6 @@ class BuiltinChecks:
 
     # -- logic over time and actions -------------------------------------------------------
     def _latch(self, e: ast.Call) -> Tuple[ast.Expr, Any]:
-        tc = _types()
-        ANY, BOOL = tc.ANY, tc.BOOL
         self._dynamic_only(e)
         if len(e.args) != 2:
             self.error(e.span, "latch() is written latch(SET, RESET), e.g. "  # type: ignore[attr-defined]
@@ -234,8 +210,6 @@ class BuiltinChecks:
         return ast.Latch(s, r, span=e.span), BOOL
 
     def _active(self, e: ast.Call) -> Tuple[ast.Expr, Any]:
-        tc = _types()
-        ANY, BOOL = tc.ANY, tc.BOOL
         self._dynamic_only(e)
         arg = e.args[0] if len(e.args) == 1 else None
         if not isinstance(arg, ast.Name) or len(arg.parts) != 1:
@@ -254,8 +228,6 @@ class BuiltinChecks:
 
     # -- zones -----------------------------------------------------------------------------
     def _polygon(self, e: ast.Call) -> Tuple[ast.Expr, Any]:
-        tc = _types()
-        ANY, Ty = tc.ANY, tc.Ty
         points: List[Tuple[float, float]] = []
         dims = set()
         ok = True
@@ -297,8 +269,6 @@ class BuiltinChecks:
                                                        bare=dims == {"bare"})
 
     def _zone(self, e: ast.Call) -> Tuple[ast.Expr, Any]:
-        tc = _types()
-        ANY, BOOL, Ty = tc.ANY, tc.BOOL, tc.Ty
         if len(e.args) != 3:
             self.error(e.span, f"{e.func}() is written {e.func}(X, Y, AREA) with AREA a polygon constant")  # type: ignore[attr-defined]
             return e, ANY

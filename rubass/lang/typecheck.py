@@ -8,49 +8,19 @@ from typing import Any, Callable, Dict, FrozenSet, List, Optional, Set, Tuple, U
 
 from . import ast
 from .builtins import BuiltinChecks
-from .errors import Diagnostic, a_noun, did_you_mean
+from .errors import Diagnostic, did_you_mean
+from .exprtypes import ANY, BARE, BOOL, STR, QuantScope, Ty, a_describe, describe, dim_noun, join, num
 from .fieldmodel import FieldModel
 from .grammar import FUNCTIONS, bad_index_message
 from .ops import BINARY, SCALAR_FUNCTIONS, UNARY, scalar_fn
 from .source import Span
-from .units import (DIMENSIONLESS, TIME, UNITS, Dimension, dim_mul, dim_sqrt, dimension_name, to_si,
-                    unit_suggestion)
+from .units import DIMENSIONLESS, TIME, UNITS, dim_mul, dim_sqrt, to_si, unit_suggestion
 from .values import UNKNOWN
 
 Value = ast.LitValue
-
-
-@dataclass(frozen=True)
-class Ty:
-    """The static type of an expression: a kind and, for numbers, a dimension.
-
-    dim None means the dimension is not known (a topic field); bare marks a number
-    written without a unit, which adopts the dimension of what it meets.
-    """
-
-    kind: str  # 'bool' | 'num' | 'str' | 'polygon' | 'any'
-    dim: Optional[Dimension] = None
-    bare: bool = False
-
-
-ANY = Ty("any")
 _CONDITION = ("bool", "any")  # the kinds a condition may have
 _NUMBER = ("num", "any")  # the kinds a number may have
-BOOL = Ty("bool")
-STR = Ty("str")
-BARE = Ty("num", DIMENSIONLESS, bare=True)
 _ELEM_TYS = {"bool": BOOL, "str": STR}  # the element kinds of an array term that are not numbers
-
-
-_NUM_TYS: Dict[Optional[Dimension], Ty] = {}
-
-
-def num(d: Optional[Dimension]) -> Ty:
-    """The type of a number of dimension d (one shared Ty per dimension: Ty is immutable)."""
-    ty = _NUM_TYS.get(d)
-    if ty is None:
-        ty = _NUM_TYS.setdefault(d, Ty("num", d))
-    return ty
 
 
 Resolution = Union[Tuple[str, ast.Expr, Ty], str]  # ('const'|'rule', expr, ty) or an error message
@@ -70,15 +40,6 @@ class Scope:
     header_nodes: Tuple[str, ...] = ()  # a behaviour's: every node the entities' headers list
 
 
-@dataclass
-class _Quant:
-    """Inside any/all/count: the array its terms run over (set by the first one)."""
-
-    func: str
-    array: Optional[ast.TopicRef] = None
-    reported: bool = False  # an array term's path was wrong, and said so: not 'needs an array term' too
-
-
 class ExprChecker(BuiltinChecks):
     """Checks one expression and returns its checked form; diagnostics go to `diags`."""
 
@@ -91,7 +52,7 @@ class ExprChecker(BuiltinChecks):
     def __init__(self, scope: Scope, diags: List[Diagnostic], warnings: Optional[List[Diagnostic]] = None) -> None:
         self.scope, self.diags = scope, diags
         self.warnings: List[Diagnostic] = [] if warnings is None else warnings
-        self.quant: Optional[_Quant] = None
+        self.quant: Optional[QuantScope] = None
 
     def error(self, span: Span, msg: str) -> None:
         self.diags.append(Diagnostic(span, msg))
@@ -103,7 +64,7 @@ class ExprChecker(BuiltinChecks):
     def condition(self, expr: ast.Expr, what: str) -> ast.Expr:
         out, ty = self.check(expr)
         if ty.kind not in ("bool", "any"):
-            self.error(expr.span, f"{what} must be a condition (true or false), not a {_describe(ty)}")
+            self.error(expr.span, f"{what} must be a condition (true or false), not a {describe(ty)}")
         return out
 
     def check(self, expr: ast.Expr) -> Tuple[ast.Expr, Ty]:
@@ -328,7 +289,7 @@ class ExprChecker(BuiltinChecks):
             return _fold(out), BOOL
         if op in ("==", "!="):
             if lt.kind != rt.kind and "any" not in (lt.kind, rt.kind):
-                self.error(e.span, f"'{op}' compares a {_describe(lt)} with a {_describe(rt)}")
+                self.error(e.span, f"'{op}' compares a {describe(lt)} with a {describe(rt)}")
             self._same_dim(lt, rt, e.span, "compares {} with {}")
             return _fold(out), BOOL
         if lt.kind not in _NUMBER or rt.kind not in _NUMBER:  # the message only when needed
@@ -339,7 +300,7 @@ class ExprChecker(BuiltinChecks):
             return _fold(out), BOOL
         if op in ("+", "-"):
             self._same_dim(lt, rt, e.span, "cannot add or subtract {} and {}")
-            return _fold(out), _join(lt, rt)
+            return _fold(out), join(lt, rt)
         if lt.dim is None or rt.dim is None:
             ty = num(None)
         else:
@@ -371,7 +332,7 @@ class ExprChecker(BuiltinChecks):
             self.error(e.duration.span, f"the duration of '{word}' needs a unit of time: write "
                                         f"'{_num_text(duration.value)} s'")
         elif dty.dim != TIME:
-            self.error(e.duration.span, f"the duration of '{word}' must be a time, not {_a_describe(dty)}")
+            self.error(e.duration.span, f"the duration of '{word}' must be a time, not {a_describe(dty)}")
         elif duration.value < 0:
             self.error(e.duration.span, f"the duration of '{word}' cannot be negative")
         elif math.isinf(duration.value):
@@ -413,7 +374,7 @@ class ExprChecker(BuiltinChecks):
         result = tys[0]
         for t in tys[1:]:
             self._same_dim(result, t, e.span, f"{e.func}() mixes {{}} and {{}}")
-            result = _join(result, t)
+            result = join(result, t)
         if e.func == "sqrt" and result.dim is not None:
             result = Ty("num", dim_sqrt(result.dim), result.bare)
         return _fold(ast.Call(e.func, tuple(args), e.span)), result
@@ -442,54 +403,16 @@ class ExprChecker(BuiltinChecks):
 
     def _want_bool(self, ty: Ty, span: Span, what: str) -> None:
         if ty.kind not in ("bool", "any"):
-            self.error(span, f"{what} needs a condition (true or false), not a {_describe(ty)}")
+            self.error(span, f"{what} needs a condition (true or false), not a {describe(ty)}")
 
     def _want_num(self, ty: Ty, span: Span, what: str) -> None:
         if ty.kind not in ("num", "any"):
-            self.error(span, f"{what} needs a number, not a {_describe(ty)}")
+            self.error(span, f"{what} needs a number, not a {describe(ty)}")
 
     def _same_dim(self, a: Ty, b: Ty, span: Span, template: str) -> None:
         if a.kind == b.kind == "num" and a.dim is not None and b.dim is not None \
                 and not a.bare and not b.bare and a.dim != b.dim:
-            self.error(span, template.format(_dim_noun(a.dim), _dim_noun(b.dim)))
-
-
-def _join(a: Ty, b: Ty) -> Ty:
-    """The type of a + b, min(a, b), max(a, b), the same whichever comes first: a known dimension
-    wins over an unknown one (a topic field takes the dimension of what it meets, §4), which wins
-    over a bare number's; two different known dimensions (an error, said by _same_dim) give an
-    unknown one, so that what uses the sum reports nothing more."""
-    if a.kind != "num" or b.kind != "num":  # 'any': an unknown field, or a mistake already said
-        known = a if a.kind == "num" else b
-        return known if known.kind == "num" and not known.bare else num(None)
-    if a.dim is not None and not a.bare and b.dim is not None and not b.bare:
-        return a if a.dim == b.dim else num(None)
-    for ty in (a, b):
-        if ty.dim is not None and not ty.bare:
-            return ty
-    if a.dim is None or b.dim is None:
-        return num(None)
-    return a  # both bare
-
-
-def _dim_noun(d: Dimension) -> str:
-    """'a length', 'a plain number' (no dimension: a quaternion's component, cpu(), 50 %)."""
-    return "a plain number" if d == DIMENSIONLESS else a_noun(dimension_name(d))
-
-
-def _a_describe(ty: Ty) -> str:
-    """'a length', 'a plain number', 'a condition': what a value is, its dimension named when known."""
-    if ty.kind == "num" and ty.dim is not None and not ty.bare:
-        return _dim_noun(ty.dim)
-    return "a " + _describe(ty)
-
-
-def _describe(ty: Ty) -> str:
-    if ty.kind == "num":
-        if ty.bare or ty.dim is None:
-            return "number"
-        return f"number ({dimension_name(ty.dim)})"
-    return {"bool": "condition", "str": "string", "any": "value", "polygon": "polygon"}[ty.kind]
+            self.error(span, template.format(dim_noun(a.dim), dim_noun(b.dim)))
 
 
 def _written(e: ast.Num) -> str:
