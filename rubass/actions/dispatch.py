@@ -18,10 +18,14 @@ Report = Callable[[Dict[str, Any]], None]
 
 
 class Dispatcher:
-    def __init__(self, runners: Dict[str, ActionRunner], report: Report, ros_now: Callable[[], float]) -> None:
+    def __init__(self, runners: Dict[str, ActionRunner], report: Report, ros_now: Callable[[], float],
+                 topic_name: Callable[[str], str] = str) -> None:
+        """`topic_name`: the name a spec's topic has on the robot (namespace and remappings applied),
+        as a start's `cause` names it."""
         self.runners = runners
         self.report = report
         self.ros_now = ros_now
+        self.topic_name = topic_name
         self.latencies: List[float] = []  # seconds, last 1000 starts
         self.last_start = "none"  # the last start and why, for /diagnostics
         self.orphans: List[Any] = []  # (behaviour, key): latched, from a spec a reload replaced
@@ -71,7 +75,7 @@ class Dispatcher:
     def report_event(self, e: Event, b: CheckedBehaviour, rules: tuple, cause: Any) -> None:
         latency: Optional[float]
         if isinstance(cause, Message) and cause.received:
-            source, latency = f"message on {cause.topic}", time.time() - cause.received
+            source, latency = f"message on {self.topic_name(cause.topic)}", time.time() - cause.received
         elif isinstance(cause, NodeSample):  # from the sample's instant, or the deadline it came with
             source, latency = f"node sample of {cause.node}", max(0.0, self.ros_now() - e.time)
         elif cause == "reset":

@@ -35,6 +35,16 @@ def _text(v: Any) -> str:
     return "unknown" if v is None or (v is not True and v is not False) else ("true" if v else "false")
 
 
+def topic_shown(name: str, resolved: Optional[str], written_in: str = "the spec") -> str:
+    """A topic (or service) as the robot names it (namespace and remappings applied), and as `written_in`
+    wrote it when that is more than a leading '/' away: `/base/cmd_vel (cmd_vel in the spec)`."""
+    if not resolved or resolved == name:
+        return name
+    if resolved == "/" + name.lstrip("/"):
+        return resolved
+    return f"{resolved} ({name} in {written_in})"
+
+
 def unknown_reasons(spec: CheckedSpec, rule_key: str, topics: Dict[str, Dict[str, Any]],
                     nodes: Dict[str, Dict[str, Any]], field_errors: Dict[Tuple[str, str], str]) -> List[str]:
     """Why a rule may be unknown: silent topics, bad fields, unmeasurable nodes."""
@@ -43,7 +53,7 @@ def unknown_reasons(spec: CheckedSpec, rule_key: str, topics: Dict[str, Dict[str
         if isinstance(e, ast.TopicRef) and e.path:
             t = topics.get(e.topic, {})
             if not t.get("messages"):
-                why.append(f"no message on {e.topic} yet")
+                why.append(f"no message on {topic_shown(e.topic, t.get('resolved'))} yet")
             for err in t.get("errors", []):
                 why.append(err)
             fe = field_errors.get((e.topic, str(e.path)))

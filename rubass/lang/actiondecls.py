@@ -32,7 +32,12 @@ class ActionDecls:
                     wanted.append((resolve(d.path, base), d.span))
                 except PathError as exc:
                     self.error(d.span, f"cannot import '{d.path}': {exc}")
-        wanted += [(os.path.abspath(p), Span(p, 0, 0)) for p in extra]
+        for p in extra:  # given on the command line or in ~actions: relative to the working directory
+            try:
+                wanted.append((resolve(p, os.getcwd()), Span(p, 0, 0)))
+            except PathError as exc:
+                self.error(Span(p, 0, 0), f"cannot use the action library '{p}': {exc}")
+                self._unusable_libraries.append(p)  # its actions are not "undefined": this error says why
         for path, span in wanted:
             if path in loaded:
                 continue

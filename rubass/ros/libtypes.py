@@ -158,7 +158,8 @@ def after_failed_check(path: str, extra: Sequence[str],
     try:
         spec = parse_source(src)
         base = os.path.dirname(os.path.abspath(path))
-        files = [resolve(d.path, base) for d in spec.decls if isinstance(d, ast.Import)] + list(extra)
+        files = [resolve(d.path, base) for d in spec.decls if isinstance(d, ast.Import)] \
+            + [resolve(p, os.getcwd()) for p in extra]
     except (SpecError, PathError):
         return [], [], sources
     warnings = graph_warnings(spec, model) if model is not None else []

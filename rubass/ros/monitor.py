@@ -73,7 +73,7 @@ from .clockjump import ClockJump
 from ..actions.errorguard import ErrorGuard
 from ..actions.keeper import LatchKeeper
 from ..actions.latches import Latch, LatchFile, undeclared
-from .params import MonitorConfig, spec_warnings
+from .params import MonitorConfig, relative_note, spec_warnings
 from .gcfreeze import freeze_heap
 from .timerslack import exact_timers
 from .priority import describe, thread_nice_values
@@ -115,12 +115,19 @@ class Monitor(Reloading):
         try:
             spec = load_spec(self.config.spec, self.config.actions)
         except SpecError as exc:  # with its libraries' errors, as `rubass check` prints them: all in one run
-            raise StartupError(render_failed_check(exc, self.config.spec, self.config.actions)) from None
+            raise StartupError(self._failed_text(exc)) from None
         self._check_overload_actions(spec)
         self._check_actions(spec)
         for w in spec_warnings(spec.warnings, self.config):
             rospy.logwarn("rubass: %s", w.render(spec.sources))
         return spec, self._runners(spec, {})
+
+    def _failed_text(self, exc: SpecError) -> str:
+        """Every error of a spec that did not check, as `rubass check` prints them; where a relative
+        ~spec or ~actions path was looked for when a file it names is missing."""
+        text = render_failed_check(exc, self.config.spec, self.config.actions)
+        note = relative_note(self.config)
+        return f"{text}\n{note}" if note else text
 
     def _check_overload_actions(self, spec: CheckedSpec) -> None:
         missing = [a for a in self.config.overload_actions if a not in spec.actions]
@@ -163,7 +170,7 @@ class Monitor(Reloading):
         """ROS scaffolding, then enforcement. A spec that cannot be used leaves the monitor up but not
         enforcing: ERROR in /diagnostics, no ~heartbeat, until a reload brings a usable one."""
         self.outputs = Outputs()
-        self.dispatcher = Dispatcher({}, self.outputs.event, _ros_now)
+        self.dispatcher = Dispatcher({}, self.outputs.event, _ros_now, rospy.resolve_name)
         self.overload = OverloadGuard(self.config.overload_actions, 1.0, _log, self.outputs.event)
         self.keeper = LatchKeeper(LatchFile(self.config.state_file, self.config.spec, rosgraph.get_master_uri()),
                                   _log, self.outputs.event)
@@ -447,7 +454,7 @@ class Monitor(Reloading):
         data_errors = loop.call(self._data_errors)
         self.livecheck.use(self.spec, self.config.actions)  # after a reload: the new spec
         self.livecheck.note(self.watcher.carried_types())
-        topics = {name: {"messages": s.messages, "errors": s.errors, "type": s.type}
+        topics = {name: {"messages": s.messages, "errors": s.errors, "type": s.type, "resolved": s.resolved}
                   for s in self.watcher.status() for name in (s.spec_name,) + s.aliases}  # every spelling
         nodes = {s.spec_name: {"why": s.why} for s in self.sampler.status.values()}
         failures = self.retired_failures + sum(r.stats.failures for r in self.runners.values())

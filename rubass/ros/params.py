@@ -3,10 +3,13 @@ from __future__ import annotations
 
 import os
 from dataclasses import dataclass, field
-from typing import Any, Callable, List, Optional, Sequence
+from typing import Any, Callable, List, Optional, Sequence, Tuple
+
+import yaml
 
 from ..lang.checker import UNUSED_ACTION
 from ..lang.errors import Diagnostic, RubassError, did_you_mean
+from ..lang.paths import PathError, resolve
 from ..lang.units import FREQUENCY, parse_quantity
 
 Getter = Callable[[str, Any], Any]
@@ -30,6 +33,10 @@ class MonitorConfig:
     state_file: Optional[str] = None  # latched actions kept across restarts; None: off
     error_actions: List[str] = field(default_factory=list)  # run while a field cannot be read
     nice: Optional[int] = None  # the threads' nice value (-20 to 19); None: as started (priority.py)
+    # ~spec and ~actions paths given relative: ("~spec '../safety.rbs'", the absolute path made from `cwd`,
+    # the working directory: $ROS_HOME under roslaunch), for the note a failed read gets (relative_note)
+    relative: Tuple[Tuple[str, str], ...] = ()
+    cwd: str = ""
 
 
 KNOWN = ("spec", "actions", "rate", "node_rate", "diagnostics_rate", "master_rate", "overload_actions",
@@ -79,13 +86,55 @@ def read_rate(get: Getter, name: str, default: float, lo: float, hi: float) -> f
 
 
 def _names(get: Getter, name: str, what: str) -> List[str]:
-    """A list param, also accepted as one string separated by commas or spaces."""
+    """A list param, also accepted as one string separated by commas or spaces, or written as a YAML
+    list in one string (`<param name="overload_actions" value="[stop]"/>` hands over "[stop]")."""
     value = get(name, [])
-    if isinstance(value, str):
+    if isinstance(value, str) and value.strip().startswith("["):
+        try:
+            value = yaml.safe_load(value)
+        except yaml.YAMLError as exc:
+            mark = getattr(exc, "problem_mark", None)
+            where = f" at column {mark.column + 1}" if mark is not None else ""
+            raise ParamError(f"~{name} must be a list of {what}: {value!r} is not a YAML list{where} "
+                             f"({getattr(exc, 'problem', None) or exc})") from None
+    elif isinstance(value, str):
         value = [a for a in value.replace(",", " ").split() if a]
     if not isinstance(value, list) or not all(isinstance(a, str) and a for a in value):
         raise ParamError(f"~{name} must be a list of {what}, got {value!r}")
     return value
+
+
+def _path(name: str, value: str, relative: List[Tuple[str, str]]) -> str:
+    """A file parameter made absolute: `~` expanded, `package://PKG/…` found on ROS_PACKAGE_PATH, a
+    relative path taken from the working directory (noted in `relative`)."""
+    written = value
+    value = os.path.expanduser(value)
+    try:
+        path = resolve(value, _cwd(name, written))
+    except PathError as exc:
+        raise ParamError(f"~{name}: cannot use {written!r}: {exc}") from None
+    if not os.path.isabs(value) and not value.startswith("package://"):
+        relative.append((f"~{name} {written!r}", path))
+    return path
+
+
+def _cwd(name: str, written: str) -> str:
+    try:
+        return os.getcwd()
+    except OSError:  # the folder it was started in was removed
+        raise ParamError(f"~{name}: {written!r} is relative, and the monitor's working directory no longer "
+                         f"exists: give an absolute path") from None
+
+
+def relative_note(config: MonitorConfig) -> str:
+    """What a failed read adds when a path was given relative and a file it names is missing: where
+    it was looked for (roslaunch starts a node in $ROS_HOME, not in the launch file's folder)."""
+    missing = [label for label, path in config.relative if not os.path.exists(path)]
+    if not missing:
+        return ""
+    return (f"({', '.join(missing)} {'is a relative path' if len(missing) == 1 else 'are relative paths'}"
+            f", taken from the monitor's working directory {config.cwd}: roslaunch starts a node in $ROS_HOME "
+            f"(~/.ros), not in the launch file's folder; write an absolute path, $(find PKG)/… or package://PKG/…)")
 
 
 def _state_file(get: Getter, default: Optional[str]) -> Optional[str]:
@@ -116,9 +165,10 @@ def read_config(get: Getter, default_state_file: Optional[str] = None) -> Monito
     nice = get("nice", None)
     if nice is not None and (not isinstance(nice, int) or isinstance(nice, bool) or not -20 <= nice <= 19):
         raise ParamError(f"~nice must be a whole number from -20 (highest priority) to 19, got {nice!r}")
+    relative: List[Tuple[str, str]] = []
     return MonitorConfig(
-        spec=os.path.expanduser(spec),
-        actions=[os.path.expanduser(a) for a in actions],
+        spec=_path("spec", spec, relative),
+        actions=[_path("actions", a, relative) for a in actions],
         rate=read_rate(get, "rate", 50.0, 1.0, 1000.0),
         node_rate=read_rate(get, "node_rate", 10.0, 0.1, 100.0),
         diagnostics_rate=read_rate(get, "diagnostics_rate", 1.0, 0.1, 10.0),
@@ -128,6 +178,8 @@ def read_config(get: Getter, default_state_file: Optional[str] = None) -> Monito
         state_file=_state_file(get, default_state_file),
         error_actions=error_actions,
         nice=nice,
+        relative=tuple(relative),
+        cwd=_cwd("spec", spec) if relative else "",
     )
 
 

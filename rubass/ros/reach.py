@@ -14,6 +14,7 @@ from typing import Dict, List, Optional, Tuple
 import rosgraph
 import rospy
 
+from ..actions.status import topic_shown
 from . import rpc
 
 BUDGET = 0.5  # seconds for all the calls of one explanation (the runner's periodic output waits for it)
@@ -45,6 +46,7 @@ def _subscribed_type(master_uri: str, me: str, node: str, topic: str, end: float
 def explain(topic: str, published: str) -> str:
     """The reason a message of type `published` on `topic` reached no subscriber, as a sentence."""
     resolved, me, uri = rospy.resolve_name(topic), rospy.get_name(), rosgraph.get_master_uri()
+    topic = topic_shown(topic, resolved, "the action library")  # a namespace or a remap moves it
     end = time.monotonic() + BUDGET
     try:
         nodes = _subscribers(rpc.Caller(uri, BUDGET, keep_alive=False), me, resolved)

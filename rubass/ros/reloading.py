@@ -19,7 +19,6 @@ from ..lang.libtopics import running_type_changes
 from ..lang.model import CheckedSpec
 from .clockjump import horizon
 from .gcfreeze import freeze_heap
-from .libtypes import render_failed_check
 from .livecheck import live_errors
 from .topics import ros_now
 
@@ -121,8 +120,7 @@ class Reloading:
                 finally:
                     slow.cancel()
             except (SpecError, StartupError) as exc:
-                text = render_failed_check(exc, self.config.spec, self.config.actions) if isinstance(exc, SpecError) \
-                    else str(exc)
+                text = self._failed_text(exc) if isinstance(exc, SpecError) else str(exc)
                 self.rejected += 1
                 self.last_reload_error = text.splitlines()[0] if text else "error"
                 if self.spec is None:

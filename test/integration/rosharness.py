@@ -39,7 +39,7 @@ class Ros:
     def spawn(self, cmd, name, **kw):
         log = open(self.tmp / f"{name}.log", "w")
         proc = subprocess.Popen(cmd, env=kw.pop("env", self.env), stdout=kw.pop("stdout", log), stderr=subprocess.STDOUT,
-                                cwd=str(self.tmp), start_new_session=True, **kw)
+                                cwd=kw.pop("cwd", str(self.tmp)), start_new_session=True, **kw)
         proc.log_path = self.tmp / f"{name}.log"
         self.procs.append(proc)
         return proc

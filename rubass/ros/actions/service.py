@@ -12,7 +12,7 @@ import roslib.message
 import rospy
 
 from ...actions.base import ActionPlugin, Context, Skipped
-from ...actions.status import NOTHING_DONE
+from ...actions.status import NOTHING_DONE, topic_shown
 from ..rpc import proxy
 from .publish import build_message, ros_class
 
@@ -63,7 +63,7 @@ class ServicePlugin(ActionPlugin):
         not returned no other is started: a new attempt fails at once (one thread per attempt leaked)."""
         timeout = float(self.params["timeout"])
         self._previous_returned(phase)
-        service = self.params["service"]
+        service = topic_shown(self.params["service"], self.proxy.resolved_name, "the action library")  # ns, remap
         result: List[Any] = []
         stage = ["waiting"]  # then "calling": the lookup on the master ends on its own (LOOKUP_TIMEOUT)
 
