@@ -51,7 +51,8 @@ def run(args: argparse.Namespace) -> int:
         with sup:
             return _run(rows, args.reps, out, sup)
     except Interrupted as exc:  # a signal after the runs (table, plot): the processes are stopped
-        print(f"rubass experiments: interrupted by {exc.name}", file=sys.stderr)
+        print(f"rubass experiments: interrupted by {exc.name} after the runs: the plot was not drawn (see "
+              f"table.json)", file=sys.stderr)
         return exc.exit_status
 
 
@@ -61,22 +62,24 @@ def _run(rows: List[Row], reps: int, out: str, sup: Supervisor) -> int:
 
     print(f"rubass experiments: {len(rows)} rows x {reps} runs; results in {out}", file=sys.stderr)
     outcome = main_loop(rows, reps, out, sup)
-    data = results_json(rows, outcome.results)
-    if outcome.signal is not None:
-        data = _mark_interrupted(data, outcome, reps)
-    table = io.StringIO()
-    ok = print_table(data, table)
-    with open(os.path.join(out, "table.json"), "w") as fh:  # saved before anything is printed: a
-        json.dump(data, fh, indent=1)  # Ctrl-C on `demo.sh | tee` also ends tee, so printing can fail
-    _say(sys.stdout, table.getvalue())
     png = os.path.join(out, "table.png")
+    with sup.deferred():  # the table is written whole; a signal meanwhile is raised after it
+        data = results_json(rows, outcome.results)
+        if outcome.signal is not None:
+            data = _mark_interrupted(data, outcome, reps)
+        table = io.StringIO()
+        ok = print_table(data, table)
+        with open(os.path.join(out, "table.json"), "w") as fh:  # saved before anything is printed: a
+            json.dump(data, fh, indent=1)  # Ctrl-C on `demo.sh | tee` also ends tee, so printing can fail
+        _remove_plot(png)  # an earlier run's plot beside this table would disagree with it, if this one is not drawn
+    _say(sys.stdout, table.getvalue())
     if outcome.signal is None:
-        plot(data, png)
-    elif os.path.exists(png):  # an earlier run's plot beside this table would disagree with it
         try:
-            os.remove(png)
-        except OSError as exc:
-            _say(sys.stderr, f"rubass experiments: cannot remove the earlier plot {png}: {exc.strerror or exc}\n")
+            plot(data, png)
+        except Interrupted:  # a signal while drawing (about 1 s): no plot, not half of one
+            with sup.deferred(raise_after=False):
+                _remove_plot(png)
+            raise
     bags = f"{os.path.join(out, 'runs')}/ROW/N/run.bag (rubass replay SPEC BAG)"
     _say(sys.stdout, f"\ntable: {os.path.join(out, 'table.json')}\nplot:  "
                      f"{png if outcome.signal is None else '(not drawn: interrupted)'}\nbags:  {bags}\n")
@@ -88,6 +91,14 @@ def _run(rows: List[Row], reps: int, out: str, sup: Supervisor) -> int:
     if not ok:
         _say(sys.stderr, "rubass experiments: some row did not stop every time or missed the (b) target\n")
     return 0 if ok else 1
+
+
+def _remove_plot(png: str) -> None:
+    if os.path.exists(png):
+        try:
+            os.remove(png)
+        except OSError as exc:
+            _say(sys.stderr, f"rubass experiments: cannot remove the earlier plot {png}: {exc.strerror or exc}\n")
 
 
 def _say(stream: TextIO, text: str) -> None:

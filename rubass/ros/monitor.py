@@ -78,6 +78,7 @@ from .gcfreeze import freeze_heap
 from .timerslack import exact_timers
 from .priority import describe, thread_nice_values
 from .exiting import EXIT_GRACE, exit_within
+from .startup import EARLY_SIGHUP
 from .reloading import ConfigError, Reloading, StartupError
 from .topics import TopicWatcher, ros_now
 
@@ -102,6 +103,9 @@ class Monitor(Reloading):
         self.coalesced = 0
         self._stopping = False
         self._exit = threading.Event()
+        self._starting = False  # setup() runs: a reload asked meanwhile waits for its end (_reload_deferred)
+        self._start_lock = threading.Lock()
+        self._reload_deferred = False
         self.spec: Optional[CheckedSpec] = None  # None while not enforcing (no usable spec yet)
         self.runners: Dict[str, ActionRunner] = {}
         self.retired_failures = 0  # failed attempts of runners a reload replaced: `failed action attempts` is since start
@@ -177,6 +181,13 @@ class Monitor(Reloading):
         self.error_guard = ErrorGuard(self.config.error_actions, _log, self.outputs.event)
         self.clock_jump = ClockJump(self.dispatcher, _log,
                                     lambda engine: self.keeper.save(engine, self.dispatcher.orphans, self._fail_safes()))
+        # our own SIGINT/SIGTERM from here: release actions while publishers still work, then stop rospy
+        # (after rospy's own handler, publish() silently does nothing); one while the spec is read (a
+        # large one takes a second) ends the monitor once it is read, unregistered from the master
+        for sig in (signal.SIGINT, signal.SIGTERM):
+            signal.signal(sig, lambda signum, frame: self._exit.set())
+        EARLY_SIGHUP.loading()  # a SIGHUP from now on may come after the file was read: reloaded below
+        self._starting = True  # a reload asked from now until enforcement begins is run after it
         try:
             spec, runners = self.load()
         except ConfigError:
@@ -185,9 +196,14 @@ class Monitor(Reloading):
             self._not_enforcing(str(exc))
         self._install_control()
         freeze_heap()  # the one long collection (15-18 ms here), before anything is enforced (gcfreeze.py)
-        if not self.load_error:
+        if not self.load_error and not self._exit.is_set():
             self._enforce(spec, runners)
             freeze_heap()  # the engine, subscriptions and runners too: a short collection now
+        with self._start_lock:
+            self._starting = False
+            again = self._reload_deferred or EARLY_SIGHUP.pending
+        if again:  # a SIGHUP or ~reload came after the spec was read: the file may have changed since
+            self.request_reload()
 
     def _not_enforcing(self, error: str) -> None:
         self.load_error = error
@@ -235,7 +251,8 @@ class Monitor(Reloading):
                                                   f"/use_sim_time left set on a real robot?)")
                 self._exit.wait(0.01)
                 now = _ros_now()
-            rospy.loginfo("rubass: first /clock message: %.3f s", now)
+            if now != 0.0:  # not when a stop signal ended the wait
+                rospy.loginfo("rubass: first /clock message: %.3f s", now)
         return now
 
     def _on_events(self, events: List[Any], cause: Any) -> None:
@@ -263,6 +280,8 @@ class Monitor(Reloading):
         self.keeper.restore(spec.actions, runners, _ros_now())  # before the first tick
         self._withhold(spec)
         now = self._first_time()
+        if self._exit.is_set():  # stopped while waiting for /clock: nothing is enforced (latched actions stay)
+            return
         engine = Engine(spec, now)
         # inline: a message is evaluated on the thread that received it when the engine is free
         # (no hand-off to the engine's thread per message; issue 17)
@@ -294,10 +313,6 @@ class Monitor(Reloading):
         rospy.Service("~reset", Trigger, lambda req: TriggerResponse(*self.reset()))
         threading.Thread(target=self.reload_thread, name="rubass-reload", daemon=True).start()
         signal.signal(signal.SIGHUP, lambda signum, frame: self.request_reload())
-        # our own SIGINT/SIGTERM: release actions while publishers still work, then stop rospy
-        # (after rospy's own handler, publish() silently does nothing)
-        for sig in (signal.SIGINT, signal.SIGTERM):
-            signal.signal(sig, lambda signum, frame: self._exit.set())
         self.master_watch.start()
 
     def _withhold(self, spec: CheckedSpec) -> None:
@@ -507,6 +522,7 @@ class Monitor(Reloading):
             return
         loop = self.loop
         if loop is None:  # not enforcing: nothing to release
+            rospy.loginfo("rubass: stopping (nothing was enforced)")
             self._stopping = True
             self.master_watch.stop()
             return

@@ -16,7 +16,7 @@ from .monitor import ConfigError, Monitor
 from .params import HELP, ParamError, read_config, unknown_params
 from .priority import set_nice
 from .rosout_param import keep_rosout_flag
-from .startup import init_node, wants_help
+from .startup import EARLY_SIGHUP, init_node, wants_help
 
 USAGE = ("usage: rosrun rubass monitor _spec:=SPEC.rbs [_actions:=LIBRARY.yaml] [_NAME:=VALUE ...]\n"
          "The rubass monitor node: enforces the rules of SPEC on the live system until stopped (SIGINT/SIGTERM);\n"
@@ -24,21 +24,14 @@ USAGE = ("usage: rosrun rubass monitor _spec:=SPEC.rbs [_actions:=LIBRARY.yaml] 
          + HELP + "Check a spec first with: rubass check SPEC.rbs --actions LIBRARY.yaml\n")
 
 
-_EARLY_SIGHUP = b"rubass: SIGHUP before the monitor started: nothing to reload yet (the spec is read when it starts)\n"
-
-
-def early_sighup(signum: int, frame: object) -> None:
-    """SIGHUP while the monitor waits for the master: said, nothing else (os.write: see main)."""
-    os.write(2, _EARLY_SIGHUP)
+early_sighup = EARLY_SIGHUP  # SIGHUP until the monitor's own handler (startup.EarlySighup)
 
 
 def main(argv: Optional[List[str]] = None) -> int:
     if wants_help(argv):
         sys.stdout.write(USAGE)
         return 0
-    # SIGHUP reloads once the monitor runs (its handler replaces this one); before, its default would end it.
-    # os.write, not sys.stderr: a signal that lands inside a write to sys.stderr (the "waiting for the
-    # ROS master" line) would make that write reentrant, a RuntimeError that ended the process
+    # SIGHUP reloads once the monitor runs (its handler replaces this one); before, its default would end it
     signal.signal(signal.SIGHUP, early_sighup)
     code = init_node("rubass", argv, lambda text: sys.stderr.write(f"rubass: {text}\n"))
     if code is not None:

@@ -50,6 +50,9 @@ class Reloading:
     load_error: str
     _reload_lock: threading.RLock
     _reload_wanted: threading.Event
+    _starting: bool
+    _start_lock: threading.Lock
+    _reload_deferred: bool
 
     def request_reload(self) -> None:
         """From the SIGHUP handler: wake the reload thread. A request that arrives while another
@@ -75,6 +78,13 @@ class Reloading:
 
     def reload(self, reason: str) -> Tuple[bool, str]:
         """Re-read spec and libraries; swap atomically, or keep the old rules on any error."""
+        with self._start_lock:
+            if self._starting:  # the spec was read, enforcement not begun: once it is, read again (setup)
+                self._reload_deferred = True
+                rospy.loginfo("rubass: reload (%s) asked while the monitor starts: it reads the spec again as "
+                              "soon as it enforces", reason)
+                return False, ("the monitor is still starting (reading its spec, or waiting for the first "
+                               "/clock): it reads the spec again as soon as it enforces")
         with self._reload_lock:
             t0 = time.monotonic()
             try:
@@ -84,8 +94,6 @@ class Reloading:
                 self._check_running_types(spec)
                 self._check_live_types(spec)
                 t_check = time.monotonic()
-                if self.spec is not None and self.loop is None:
-                    raise StartupError(f"not enforcing yet: {self._why_not()}; reload once it enforces")
                 if self.spec is None:  # not enforcing yet: this spec is the first usable one
                     self._enforce(spec, self._runners(spec, {}))
                     self.reloads += 1

@@ -2,6 +2,7 @@
 that is not up yet, which SIGINT or SIGTERM must end with one line, not a traceback."""
 from __future__ import annotations
 
+import os
 import signal
 import sys
 import time
@@ -14,6 +15,31 @@ class _Stopped(BaseException):
     """A signal ended the wait for the master: a BaseException, so that rospy's `except Exception`
     around its retries lets it through."""
 
+
+class EarlySighup:
+    """The SIGHUP handler before the monitor's own: while the node waits for the master nothing has been
+    read, so a SIGHUP is only said; once the monitor reads its spec (`loading()`), one may come after the
+    file was read, so it is noted (`pending`) and the monitor reloads as soon as its own handler is in
+    place (it was dropped: an edit saved then was never enforced). os.write, not sys.stderr: a signal
+    that lands inside a write to sys.stderr would make that write reentrant (a RuntimeError)."""
+
+    def __init__(self) -> None:
+        self.reading = False
+        self.pending = False
+
+    def loading(self) -> None:
+        self.reading, self.pending = True, False
+
+    def __call__(self, signum: int, frame: object) -> None:
+        if self.reading:
+            self.pending = True
+            os.write(2, b"rubass: SIGHUP while the monitor starts: it reads the spec again once it runs\n")
+        else:
+            os.write(2, b"rubass: SIGHUP before the monitor started: nothing to reload yet (the spec is read when "
+                        b"it starts)\n")
+
+
+EARLY_SIGHUP = EarlySighup()
 
 STOP_GRACE = 1.0  # s: nothing was started, so rospy gets this long to shut down before the process exits
 
@@ -80,8 +106,10 @@ def init_node(name: str, argv: Optional[List[str]], say: Callable[[str], None]) 
 
     previous = {s: signal.signal(s, stop) for s in (signal.SIGINT, signal.SIGTERM)}
     failed = ""
+    answered = False
     try:
         _wait_for_master(uri, say, stopped)  # rospy waits only if no _param:= is given; with one it raises at once
+        answered = True
         rospy.init_node(name, argv=argv, disable_signals=True)
     except _Stopped:
         pass
@@ -100,23 +128,28 @@ def init_node(name: str, argv: Optional[List[str]], say: Callable[[str], None]) 
     if not (stopped or failed or rospy.is_shutdown()):
         keep_console_log()
         return None
-    say(failed or f"stopped before the ROS master at {uri} answered; nothing was started")
+    say(failed or (f"stopped while starting (the ROS master at {uri} had answered); nothing was enforced" if answered
+                   else f"stopped before the ROS master at {uri} answered; nothing was started"))
     code = 1 if failed else 0
     exit_within(STOP_GRACE, code, "nothing had been started")
     rospy.signal_shutdown("stopped before start")
     return code
 
 
+MASTER_CHECK_TIMEOUT = 1.0  # s: a master that accepts connections but does not answer (paused, hung) is not up
+
+
 def master_answers(uri: str) -> bool:
-    """Whether the master at `uri` answers: rosgraph.is_master_online without its bare `except`, which
-    swallowed the exception a stop signal's handler raised inside it (the signal was lost)."""
-    import rosgraph
+    """Whether the master at `uri` answers getPid within MASTER_CHECK_TIMEOUT: rosgraph.is_master_online
+    had no timeout (a paused master held the wait, and its "waiting" line, for good) and a bare
+    `except`, which swallowed the exception a stop signal's handler raised inside it (the signal was lost)."""
+    from .rpc import Caller
 
     try:
-        rosgraph.Master("/rubass", master_uri=uri).getPid()
-    except Exception:  # noqa: BLE001 - refused, reset, a fault: not answering (a signal's BaseException passes)
+        code, _, _ = Caller(uri, MASTER_CHECK_TIMEOUT, keep_alive=False).call("getPid", "/rubass")
+    except Exception:  # noqa: BLE001 - refused, timed out, a bad URI or answer: not up (a signal's BaseException passes)
         return False
-    return True
+    return code == 1
 
 
 def _wait_for_master(uri: str, say: Callable[[str], None], stopped: List[int]) -> None:

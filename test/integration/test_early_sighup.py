@@ -108,3 +108,26 @@ def test_a_sighup_that_lands_inside_a_write_to_stderr_does_not_end_the_process()
     out = subprocess.run([sys.executable, "-c", code], cwd=ROOT, capture_output=True, text=True, timeout=30)
     assert (out.returncode, out.stdout) == (0, "alive\n"), out.stderr
     assert "SIGHUP before the monitor started" in out.stderr  # said on the real stderr, by os.write
+
+
+@pytest.mark.parametrize("script", ["monitor", "agent"])
+def test_sigterm_during_the_imports_says_so_and_exits_143(tmp_path, script):
+    """An acceptance sweep: a SIGTERM in the first second (the imports) killed the process with no line."""
+    proc = subprocess.Popen([sys.executable, os.path.join(ROOT, "scripts", script)], env=_env(tmp_path),
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, start_new_session=True)
+    try:
+        end = time.monotonic() + 10.0
+        while not _ignores_sighup(proc.pid) and proc.poll() is None and time.monotonic() < end:
+            time.sleep(0.001)  # past the script's first lines, into the imports
+        time.sleep(0.05)
+        proc.send_signal(signal.SIGTERM)
+        out, err = proc.communicate(timeout=15)
+        assert "Traceback" not in err, err
+        if proc.returncode == 143:
+            assert "stopped while loading; nothing was started" in err, err
+        else:  # it had reached the wait for the master, whose own handler says so
+            assert proc.returncode == 0 and "stopped before the ROS master" in err, (proc.returncode, err)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.wait()

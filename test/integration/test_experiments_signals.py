@@ -195,15 +195,15 @@ def test_a_ctrl_c_that_lands_inside_the_master_check_stops_the_command(tmp_path)
     once; a second Ctrl-C is ignored while stopping), so the experiments went on. Here the signal is
     raised from inside the first master check; the runner's PrivateMaster must raise Interrupted and
     leave no master running (the one it had started was left running when its start was cut short)."""
-    code = ("import os, signal, sys\nimport rosgraph.masterapi\n"
+    code = ("import os, signal, sys\n"
             "from rubass_experiments.master import PrivateMaster\nfrom rubass_experiments.procs import Interrupted, Supervisor\n"
             "import subprocess\nstarted = []\nPopen = subprocess.Popen\n"
             "def popen(*a, **k):\n    started.append(Popen(*a, **k))\n    return started[-1]\n"
             "subprocess.Popen = popen\n"
-            "real = rosgraph.masterapi.Master.getPid\nsent = []\n"
-            "def getpid(self):\n    if not sent:\n        sent.append(1)\n        os.kill(os.getpid(), signal.SIGINT)\n"
-            "    return real(self)\n"
-            "rosgraph.masterapi.Master.getPid = getpid\n"
+            "import rubass.ros.rpc as rpc\nreal = rpc.Caller.call\nsent = []\n"
+            "def call(self, *a):\n    if not sent:\n        sent.append(1)\n        os.kill(os.getpid(), signal.SIGINT)\n"
+            "    return real(self, *a)\n"
+            "rpc.Caller.call = call\n"
             "try:\n    with Supervisor():\n        m = PrivateMaster(sys.argv[1])\n"
             "        print('started', m.process.pid, flush=True)\n        m.stop()\n"
             "except Interrupted:\n    print('interrupted', flush=True)\n"
@@ -212,3 +212,4 @@ def test_a_ctrl_c_that_lands_inside_the_master_check_stops_the_command(tmp_path)
                          text=True, timeout=60)
     assert out.stdout == "interrupted\nleft running: []\n", (out.stdout, out.stderr)
     assert "Traceback" not in out.stderr, out.stderr
+

@@ -105,9 +105,9 @@ _SWALLOWED = ("import rubass.ros.startup as startup\n"  # library code with a ba
               "    except:  # noqa: E722 - as rosgraph.masterapi.Master.is_online does\n        return False\n"
               "    return False\n"
               "startup.master_answers = online\n")
-_IN_THE_CALL = ("import rosgraph.masterapi\nreal = rosgraph.masterapi.Master.getPid\n"  # inside the XML-RPC call
-                "def getpid(self):\n    os.kill(os.getpid(), signal.SIGTERM)\n    time.sleep(0.01)\n    return real(self)\n"
-                "rosgraph.masterapi.Master.getPid = getpid\n")
+_IN_THE_CALL = ("import rubass.ros.rpc as rpc\nreal = rpc.Caller.call\n"  # inside the XML-RPC call
+                "def call(self, *a):\n    os.kill(os.getpid(), signal.SIGTERM)\n    time.sleep(0.01)\n    return real(self, *a)\n"
+                "rpc.Caller.call = call\n")
 
 
 @pytest.mark.parametrize("patch", [_IN_THE_CALL, _SWALLOWED], ids=["in-the-call", "swallowed"])

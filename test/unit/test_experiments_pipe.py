@@ -7,7 +7,10 @@ import os
 import signal
 import sys
 
-from rubass_experiments import command, runner
+import pytest
+
+from rubass_experiments import command, runner, table
+from rubass_experiments.procs import Interrupted, Supervisor
 from rubass_experiments.rows import ROWS
 
 
@@ -23,7 +26,7 @@ def test_an_interrupted_experiment_saves_its_table_and_exits_130_with_its_reader
     monkeypatch.setattr(sys, "stdout", out)
     monkeypatch.setattr(sys, "stderr", err)
     try:
-        status = command._run([ROWS[0]], 2, str(tmp_path), None)
+        status = command._run([ROWS[0]], 2, str(tmp_path), Supervisor(signals=False))
     finally:
         monkeypatch.undo()
     assert status == 130
@@ -38,7 +41,7 @@ def test_an_interrupted_experiment_removes_an_earlier_runs_plot(tmp_path, monkey
     its own partial table.json (the plot disagreed with the table)."""
     (tmp_path / "table.png").write_bytes(b"\x89PNG an earlier run")
     monkeypatch.setattr(runner, "main_loop", lambda rows, reps, out, sup: runner.Outcome([], signal.SIGINT))
-    assert command._run([ROWS[0]], 2, str(tmp_path), None) == 130
+    assert command._run([ROWS[0]], 2, str(tmp_path), Supervisor(signals=False)) == 130
     assert not (tmp_path / "table.png").exists()
     assert "(not drawn: interrupted)" in capsys.readouterr().out
 
@@ -71,3 +74,22 @@ def test_a_run_over_the_target_is_named_with_where_its_time_went(capsys):
     text = out.getvalue()
     assert "(b) over 10 ms in 1 run(s): Spin (0.2 s) run 1 12.6 ms (1.2 in the monitor, 11.4 to the base)" in text
     assert "the monitor ran at its starting priority in 1 run(s), not at nice -10" in text
+
+
+def test_a_signal_while_the_plot_is_drawn_leaves_no_earlier_plot_beside_the_new_table(tmp_path, monkeypatch):
+    """An acceptance sweep: a signal in the second the plot takes to draw (after every run) left an earlier
+    run's table.png beside the new table.json, the new plot not drawn; the docs say it is removed."""
+    png = tmp_path / "table.png"
+    png.write_bytes(b"\x89PNG an earlier run")
+    monkeypatch.setattr(runner, "main_loop", lambda rows, reps, out, sup: runner.Outcome([]))
+
+    def drawing(data, path):
+        with open(path, "wb") as fh:
+            fh.write(b"half a plot")
+        raise Interrupted(signal.SIGINT)  # the handler raises it inside the drawing
+
+    monkeypatch.setattr(table, "plot", drawing)
+    with pytest.raises(Interrupted):
+        command._run([ROWS[0]], 1, str(tmp_path), Supervisor(signals=False))
+    assert not png.exists()
+    assert "interrupted" not in json.loads((tmp_path / "table.json").read_text())  # whole: every run finished

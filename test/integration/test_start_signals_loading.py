@@ -1,0 +1,124 @@
+"""Signals in the monitor's start, after the master answered and before it enforces (an acceptance sweep
+of process lifecycles): a SIGHUP while the spec was read was said ("nothing to reload yet") and dropped,
+so an edit saved then was never enforced; a SIGTERM then killed the process with no line, its node left
+registered; a master that accepted connections but never answered (paused) held the start with no
+"waiting" line; a signal during rospy's own start said the master had not answered; and a SIGINT while
+waiting for /clock logged a first /clock message and "enforcing"."""
+import os
+import signal
+import subprocess
+import sys
+import time
+
+import pytest
+
+import rosharness
+from conftest import ROOT
+
+pytestmark = pytest.mark.ros
+
+PY = "/usr/bin/python3"
+
+
+def _big_spec(path, limit, rules=6000):
+    """A spec that takes about a second to read here, with one real rule at `limit`."""
+    lines = ['import "lib.yaml";', "action primitive stop, brake, warn;", "entity f { rules:"]
+    lines += [f"  r{i}: topic /filler{i % 50}.data > {i};" for i in range(rules)]
+    lines += ["}", f"entity base {{ rules: fast: topic /speed.data > {limit}; }}", "if (base.fast) then { brake; }"]
+    path.write_text("\n".join(lines) + "\n")
+
+
+def _registered(ros, name="/rubass"):
+    import rosgraph
+
+    try:
+        state = rosgraph.Master("/t", master_uri=ros.env["ROS_MASTER_URI"]).getSystemState()
+    except Exception:  # noqa: BLE001
+        return False
+    return any(name in nodes for _, nodes in state[0] + state[1] + state[2])
+
+
+def _wait_registered(ros, proc, timeout=20.0):
+    end = time.time() + timeout
+    while not _registered(ros) and time.time() < end:
+        assert proc.poll() is None, ros.log(proc)
+        time.sleep(0.01)
+    assert _registered(ros), ros.log(proc)
+
+
+def _speed_brakes(ros, value):
+    rec = ros.probe({"listen": [{"topic": "/brake", "type": "std_msgs/Bool"}],
+                     "advertise": [{"topic": "/speed", "type": "std_msgs/Float64"}],
+                     "steps": [{"wait_subscribers": "/speed"}, {"sleep": 0.3},
+                               {"publish": "/speed", "msg": {"data": value}}, {"sleep": 1.0}]})
+    return any(r["kind"] == "recv" and r["topic"] == "/brake" for r in rec)
+
+
+def test_an_edit_saved_and_signalled_while_the_spec_is_read_is_enforced(ros, tmp_path):
+    (tmp_path / "lib.yaml").write_text(rosharness.LIB)
+    spec = tmp_path / "s.rbs"
+    _big_spec(spec, 100)  # lenient
+    mon = ros.monitor(str(spec), wait=False)
+    _wait_registered(ros, mon)
+    time.sleep(0.1)  # reading the spec now (about a second)
+    _big_spec(spec, 1)  # the engineer's stricter edit, saved, then SIGHUP
+    mon.send_signal(signal.SIGHUP)
+    ros.wait_service("/rubass/reset", mon, timeout=30)
+    rosharness.wait_log(mon, ros, "(SIGHUP) in ", timeout=30)  # "reloaded … (SIGHUP) in N ms": after the start
+    time.sleep(1.0)
+    assert _speed_brakes(ros, 2.0), ros.log(mon)  # 2 > 1: the edit holds (with the first spec, 2 < 100)
+    assert "nothing to reload yet" not in ros.log(mon), ros.log(mon)
+
+
+def test_a_sigterm_while_the_spec_is_read_ends_the_monitor_cleanly_and_unregistered(ros, tmp_path):
+    (tmp_path / "lib.yaml").write_text(rosharness.LIB)
+    spec = tmp_path / "s.rbs"
+    _big_spec(spec, 100)
+    mon = ros.monitor(str(spec), wait=False)
+    _wait_registered(ros, mon)
+    time.sleep(0.1)
+    mon.send_signal(signal.SIGTERM)
+    assert mon.wait(20) == 0, ros.log(mon)  # was -15, no line
+    assert "stopping (nothing was enforced)" in ros.log(mon), ros.log(mon)
+    assert "Traceback" not in ros.log(mon)
+    assert not _registered(ros), "the monitor's node is still registered with the master"
+
+
+def test_a_paused_master_gets_the_waiting_line_and_the_monitor_enforces_once_it_answers(ros, tmp_path):
+    os.kill(ros.master.process.pid, signal.SIGSTOP)  # accepts connections, answers nothing
+    try:
+        mon = ros.monitor(rosharness.spec(tmp_path, "entity base { rules: fast: topic /speed.data > 1; }\n"
+                                                    "if (base.fast) then { brake; }\n"), wait=False)
+        rosharness.wait_log(mon, ros, f"waiting for the ROS master at {ros.env['ROS_MASTER_URI']}", timeout=10)
+    finally:
+        os.kill(ros.master.process.pid, signal.SIGCONT)
+    ros.wait_service("/rubass/reset", mon, timeout=20)
+    assert _speed_brakes(ros, 2.0), ros.log(mon)
+
+
+def test_a_signal_during_rospys_own_start_does_not_say_the_master_never_answered():
+    code = ("import os, signal, sys, time\nimport rospy\nimport rubass.ros.startup as startup\n"
+            "startup.master_answers = lambda uri: True  # it answered\n"
+            "def init_node(*a, **k):\n    os.kill(os.getpid(), signal.SIGTERM)\n    time.sleep(0.05)\n"
+            "rospy.init_node = init_node\n"
+            "sys.exit(startup.init_node('probe', ['probe'], lambda t: sys.stderr.write(t + '\\n')))\n")
+    env = dict(os.environ, ROS_MASTER_URI="http://127.0.0.1:1", PYTHONDONTWRITEBYTECODE="1")
+    out = subprocess.run([sys.executable, "-c", code], cwd=ROOT, env=env, capture_output=True, text=True, timeout=30)
+    assert out.returncode == 0, out.stderr
+    assert "stopped while starting (the ROS master at http://127.0.0.1:1 had answered); nothing was enforced" \
+        in out.stderr, out.stderr
+    assert "before the ROS master" not in out.stderr
+
+
+def test_sigint_while_waiting_for_the_first_clock_says_no_clock_came(ros, tmp_path):
+    import rosgraph
+
+    rosgraph.Master("/t", master_uri=ros.env["ROS_MASTER_URI"]).setParam("/use_sim_time", True)
+    mon = ros.monitor(rosharness.spec(tmp_path, "entity base { rules: fast: topic /speed.data > 1; }\n"
+                                                "if (base.fast) then { brake; }\n"), wait=False)
+    rosharness.wait_log(mon, ros, "no /clock message has come yet", timeout=20)
+    mon.send_signal(signal.SIGINT)
+    assert mon.wait(20) == 0, ros.log(mon)
+    log = ros.log(mon)
+    assert "first /clock message" not in log and "rubass: enforcing" not in log, log
+    assert "stopping" in log, log
