@@ -50,9 +50,8 @@ def run(args: argparse.Namespace) -> int:
     try:
         with sup:
             return _run(rows, args.reps, out, sup)
-    except Interrupted as exc:  # a signal after the runs (table, plot): the processes are stopped
-        print(f"rubass experiments: interrupted by {exc.name} after the runs: the plot was not drawn (see "
-              f"table.json)", file=sys.stderr)
+    except Interrupted as exc:  # a signal outside the runs (setting up, or before the table): processes stopped
+        print(f"rubass experiments: interrupted by {exc.name}", file=sys.stderr)
         return exc.exit_status
 
 
@@ -76,10 +75,12 @@ def _run(rows: List[Row], reps: int, out: str, sup: Supervisor) -> int:
     if outcome.signal is None:
         try:
             plot(data, png)
-        except Interrupted:  # a signal while drawing (about 1 s): no plot, not half of one
+        except Interrupted as exc:  # a signal while drawing (about 1 s): no plot, not half of one
             with sup.deferred(raise_after=False):
                 _remove_plot(png)
-            raise
+                _say(sys.stderr, f"rubass experiments: interrupted by {exc.name} after the runs: the plot was not "
+                                 f"drawn (table: {os.path.join(out, 'table.json')})\n")
+            return exc.exit_status
     bags = f"{os.path.join(out, 'runs')}/ROW/N/run.bag (rubass replay SPEC BAG)"
     _say(sys.stdout, f"\ntable: {os.path.join(out, 'table.json')}\nplot:  "
                      f"{png if outcome.signal is None else '(not drawn: interrupted)'}\nbags:  {bags}\n")

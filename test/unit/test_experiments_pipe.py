@@ -7,8 +7,6 @@ import os
 import signal
 import sys
 
-import pytest
-
 from rubass_experiments import command, runner, table
 from rubass_experiments.procs import Interrupted, Supervisor
 from rubass_experiments.rows import ROWS
@@ -76,7 +74,7 @@ def test_a_run_over_the_target_is_named_with_where_its_time_went(capsys):
     assert "the monitor ran at its starting priority in 1 run(s), not at nice -10" in text
 
 
-def test_a_signal_while_the_plot_is_drawn_leaves_no_earlier_plot_beside_the_new_table(tmp_path, monkeypatch):
+def test_a_signal_while_the_plot_is_drawn_leaves_no_earlier_plot_beside_the_new_table(tmp_path, monkeypatch, capsys):
     """An acceptance sweep: a signal in the second the plot takes to draw (after every run) left an earlier
     run's table.png beside the new table.json, the new plot not drawn; the docs say it is removed."""
     png = tmp_path / "table.png"
@@ -89,7 +87,7 @@ def test_a_signal_while_the_plot_is_drawn_leaves_no_earlier_plot_beside_the_new_
         raise Interrupted(signal.SIGINT)  # the handler raises it inside the drawing
 
     monkeypatch.setattr(table, "plot", drawing)
-    with pytest.raises(Interrupted):
-        command._run([ROWS[0]], 1, str(tmp_path), Supervisor(signals=False))
+    assert command._run([ROWS[0]], 1, str(tmp_path), Supervisor(signals=False)) == 130
     assert not png.exists()
+    assert "interrupted by SIGINT after the runs: the plot was not drawn" in capsys.readouterr().err
     assert "interrupted" not in json.loads((tmp_path / "table.json").read_text())  # whole: every run finished
