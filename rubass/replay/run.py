@@ -8,7 +8,7 @@ from typing import Any, Dict, Iterable, List, Optional, Set, Tuple
 
 from ..engine import UNKNOWN, Engine, Event
 from ..lang.model import CheckedSpec
-from ..lang.topicnames import MONITOR_NODE, resolve
+from ..lang.topicnames import monitor_node, resolve
 
 
 def replay(spec: CheckedSpec, messages: Iterable[Tuple[float, str, Optional[Any]]], start: float, end: float,
@@ -75,15 +75,13 @@ def monitor_of(topic: str) -> str:
     """The node that published a recorded `~node_samples` topic (`/ns/rubass/node_samples` -> `/ns/rubass`);
     the default monitor for a topic of another shape (the agents' samples, a rule test's)."""
     head, _, tail = topic.rpartition("/")
-    return head if tail == "node_samples" and head.startswith("/") else MONITOR_NODE
+    return head if tail == "node_samples" and head.startswith("/") else monitor_node()
 
 
-def resolve_node(name: str, monitor: str = MONITOR_NODE) -> str:
-    """A node name as the monitor `monitor` resolves it (rospy.resolve_name): relative names in its
-    namespace, private `~x` under it."""
-    if name.startswith("/") or name.startswith("~"):
-        return resolve(name, monitor)
-    return resolve("/" + monitor.rstrip("/").rpartition("/")[0].lstrip("/") + "/" + name)
+def resolve_node(name: str, monitor: Optional[str] = None) -> str:
+    """A node name as the monitor `monitor` (monitor_node() by default) resolves it (rospy.resolve_name):
+    relative names in its namespace, private `~x` under it."""
+    return resolve(name, monitor)
 
 
 class NodeNames:

@@ -158,3 +158,36 @@ def test_the_report_replays_every_spelling_of_a_topic(write, tmp_path):
     assert not run.error and not run.warnings, (run.error, run.warnings)
     starts = sorted((e.behaviour, round(e.time, 3)) for e in run.events if e.kind == "start")
     assert starts == [(1, 0.5), (2, 0.5), (3, 1.0)]
+
+
+@pytest.mark.parametrize("name,resolved", [("x", "/robot1/x"), ("/x", "/x"), ("~x", "/robot1/rubass/x"),
+                                           ("a/b", "/robot1/a/b"), ("~x/y", "/robot1/rubass/x/y")])
+def test_names_resolve_in_ros_namespace_as_rosrun_would_start_the_monitor(name, resolved, monkeypatch):
+    """A namespaced robot (an acceptance sweep of bringups): the live monitor in /robot1 reads `cmd_vel` as
+    /robot1/cmd_vel, but replay, rule tests and check --live read it as /cmd_vel; with ROS_NAMESPACE set
+    (as rosrun reads it) they resolve as that monitor does."""
+    monkeypatch.setenv("ROS_NAMESPACE", "robot1")
+    assert resolve(name) == resolved
+    rosgraph_names = pytest.importorskip("rosgraph.names")
+    assert rosgraph_names.resolve_name(name, "/robot1/rubass") == resolved
+
+
+def test_rule_tests_in_a_namespace_feed_the_namespaced_topic(write, capsys, monkeypatch):
+    write("lib.yaml", LIB)
+    write("robot.rbs", SPEC)
+    path = write("t.test.yaml", """spec: robot.rbs
+tests:
+  - name: the robot's own topic, in its namespace
+    duration: 2 s
+    topics:
+      /robot1/x: {type: std_msgs/Float64, messages: [{at: 0.5 s, data: 2}]}
+    expect:
+      - {at: 0.5 s, start: on_rel}
+      - {never: on_abs}
+""")
+    monkeypatch.setenv("ROS_NAMESPACE", "/robot1/")
+    code, out, err = run(capsys, "test", path)
+    assert code == 0, out + err
+    monkeypatch.delenv("ROS_NAMESPACE")
+    code, out, err = run(capsys, "test", path)  # at the root, `x` is /x: the test's topic is not read
+    assert code == 1 and "warning: the spec reads no topic /robot1/x" in err, out + err
