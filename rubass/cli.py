@@ -7,6 +7,7 @@ import sys
 from typing import List, Optional, Sequence
 
 from .lang import SpecError, format_spec, parse_source
+from .lang.paths import file_arg
 from .lang.topicnames import spellings
 from .replay.command import register as register_replay
 from .testing.command import register as register_test
@@ -99,7 +100,7 @@ def _parser() -> argparse.ArgumentParser:
                                 "paper's experiments.")
     sub = p.add_subparsers(dest="command", metavar="COMMAND")
     c = sub.add_parser("check", help="check specs for errors")
-    c.add_argument("spec", nargs="+", metavar="SPEC")
+    c.add_argument("spec", nargs="+", metavar="SPEC", type=file_arg)
     c.add_argument("--actions", action="append", default=[], metavar="LIB.yaml",
                    help="an action library to load besides the spec's imports (repeatable)")
     c.add_argument("-q", "--quiet", action="store_true",

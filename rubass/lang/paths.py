@@ -69,6 +69,17 @@ def resolve(path: str, base_dir: str, env: Optional[Mapping[str, str]] = None) -
     return os.path.normpath(path if os.path.isabs(path) else os.path.join(base_dir, path))
 
 
+def file_arg(path: str) -> str:
+    """A spec or library named on a command line: `package://PKG/sub/path` as the file it names when the
+    package is found (left as written otherwise: reading it then says why), any other path as given."""
+    if path.startswith("package://"):
+        try:
+            return resolve(path, os.getcwd())
+        except (PathError, OSError):
+            return path
+    return path
+
+
 def clear_cache(roots: Iterable[str] = ()) -> None:
     """Forget scanned package folders (all of them when roots is empty)."""
     if not roots:

@@ -14,6 +14,13 @@ MAX_BYTES = 4 * 1024 * 1024
 def read_source(path: str, what: str = "spec") -> Tuple[Optional[Source], Optional[Diagnostic]]:
     """The file as a Source, or None and a diagnostic that says what is wrong with it."""
     here = Span(path, 0, 0)
+    if path.startswith("package://"):  # one its caller could not resolve (file_arg): why, not "no such file"
+        from .paths import PathError, resolve
+
+        try:
+            resolve(path, "/")
+        except PathError as exc:
+            return None, Diagnostic(here, f"cannot read {what}: {exc}")
     try:
         if os.path.isdir(path):
             return None, Diagnostic(here, f"cannot read {what}: it is a directory")

@@ -11,6 +11,7 @@ from typing import Any, Iterable, Iterator, List, Sequence, Set, Tuple
 
 from ..lang import SpecError, load_spec
 from . import report
+from ..lang.paths import file_arg
 from ..lang.topicnames import resolve, spellings
 
 
@@ -18,7 +19,7 @@ def register(sub: "argparse._SubParsersAction[argparse.ArgumentParser]") -> None
     p = sub.add_parser("replay", help="run a spec over a ROS 1 recording (no master needed)",
                        description="Evaluate SPEC over the messages of BAG at their recorded times, "
                                    "with ticks at the monitor's rate in between.")
-    p.add_argument("spec", metavar="SPEC")
+    p.add_argument("spec", metavar="SPEC", type=file_arg)
     p.add_argument("bag", metavar="BAG")
     p.add_argument("--json", action="store_true", help="print one JSON object per line (docs/replay.md)")
     p.add_argument("--plot", metavar="FILE.png", type=plot_path,

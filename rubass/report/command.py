@@ -7,6 +7,7 @@ import sys
 
 from ..lang import SpecError, load_spec
 from ..lang.errors import in_text_order
+from ..lang.paths import file_arg
 from ..replay.command import is_bag
 
 
@@ -16,7 +17,7 @@ def register(sub: "argparse._SubParsersAction[argparse.ArgumentParser]") -> None
                                    "and refs; the hazard -> rule -> behaviour -> test matrix with gaps; test results; "
                                    "each recording's timeline and events with their witnesses; the monitor's "
                                    "measured reaction. Exit 0 written, 1 a test fails or an input is bad, 2 usage.")
-    p.add_argument("spec", metavar="SPEC")
+    p.add_argument("spec", metavar="SPEC", type=file_arg)
     p.add_argument("--tests", nargs="+", default=[], metavar="FILE.test.yaml", help="rule test files to run")
     p.add_argument("--bag", nargs="+", default=[], metavar="BAG", help="recordings to replay")
     p.add_argument("--hazards", metavar="RISK.yaml", help="the risk-assessment table (hazards: [{id, title, …}])")

@@ -109,11 +109,12 @@ def _path(name: str, value: str, relative: List[Tuple[str, str]]) -> str:
     relative path taken from the working directory (noted in `relative`)."""
     written = value
     value = os.path.expanduser(value)
-    try:
-        path = resolve(value, _cwd(name, written))
+    given_relative = not os.path.isabs(value) and not value.startswith("package://")
+    try:  # the working directory only for a relative path (one started in a removed folder still runs)
+        path = resolve(value, _cwd(name, written) if given_relative else "/")
     except PathError as exc:
         raise ParamError(f"~{name}: cannot use {written!r}: {exc}") from None
-    if not os.path.isabs(value) and not value.startswith("package://"):
+    if given_relative:
         relative.append((f"~{name} {written!r}", path))
     return path
 
@@ -179,7 +180,7 @@ def read_config(get: Getter, default_state_file: Optional[str] = None) -> Monito
         error_actions=error_actions,
         nice=nice,
         relative=tuple(relative),
-        cwd=_cwd("spec", spec) if relative else "",
+        cwd=os.getcwd() if relative else "",  # read above for the first of them
     )
 
 

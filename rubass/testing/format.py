@@ -7,6 +7,7 @@ import re
 from typing import Any, Callable, Dict, List, Tuple, TypeVar
 
 from ..lang.errors import did_you_mean
+from ..lang.paths import PathError, resolve as resolve_path
 from ..lang.units import MEMORY, TIME, FREQUENCY, parse_quantity
 from .cases import UNSET, Case, Expect, MessageInput, NodeSampleInput, TestFile, TopicInput
 from .messages import MessageError, NoRosPython, Path, field_info, field_problems, message_class, parse_path
@@ -110,14 +111,14 @@ class _Reader:
                 self.errors.append(self.fail(c.line, f"a second test named '{c.name}' (the first is at line "
                                                      f"{seen[c.name]})"))
             seen.setdefault(c.name, c.line)
-        spec_path = os.path.normpath(os.path.join(base, spec)) if spec else ""
+        spec_path = _file_in(base, spec) if spec else ""
         errors = sorted(self.errors, key=lambda e: e.line)  # stable: one line's errors as found
         return TestFile(self.path, spec_path, top.at("spec"), actions, cases, model, errors)
 
     def actions(self, top: LDict, base: str) -> List[str]:
         listed = top.get("actions", LList())
         listed = [listed] if isinstance(listed, str) else self.seq(listed, top.at("actions"), "actions")
-        return [os.path.join(base, str(a)) for a in listed]
+        return [_file_in(base, str(a)) for a in listed]
 
     def model(self, top: LDict, base: str) -> Any:
         """The system model file named by `model:` (relative to the test file)."""
@@ -405,3 +406,12 @@ def read_test_file(path: str) -> TestFile:
     except TestFileError as exc:
         exc.before = list(reader.errors)
         raise
+
+
+def _file_in(base: str, path: str) -> str:
+    """A file a test file names: relative to the test file, absolute, or `package://PKG/…` (left as
+    written when the package is not found: reading it then says why)."""
+    try:
+        return resolve_path(path, base)
+    except PathError:
+        return path

@@ -14,10 +14,11 @@ from conftest import ROOT
 pytestmark = pytest.mark.ros
 
 PY = "/usr/bin/python3"
-LIB = ("actions:\n  stop: {plugin: publish, topic: safety_cmd, type: geometry_msgs/Twist, message: {}, rate: 20 Hz}\n")
-SPEC = ('import "lib.yaml";\naction primitive stop;\n'
+LIB = ("actions:\n  stop: {plugin: publish, topic: safety_cmd, type: geometry_msgs/Twist, message: {}, rate: 20 Hz}\n"
+       "  crawl: {plugin: limit, input: nav_vel, topic: crawl_out, linear_x: [-0.1 m/s, 0.1 m/s]}\n")
+SPEC = ('import "lib.yaml";\naction primitive stop, crawl;\n'
         "entity base { rules: fast: topic cmd_vel.linear.x > 1.0 m/s; odd: topic odom.twist.twist.linear.x > 5 m/s; }\n"
-        "if (base.fast or base.odd) then { stop; }\n")
+        "if (base.fast or base.odd) then { stop; crawl; }\n")
 
 
 def test_a_namespaced_remapped_monitor_names_the_topics_it_uses_and_reads_a_list_param_written_in_a_string(ros, tmp_path):
@@ -30,6 +31,7 @@ def test_a_namespaced_remapped_monitor_names_the_topics_it_uses_and_reads_a_list
       <param name="spec" value="{tmp_path / 'safety.rbs'}"/>
       <param name="overload_actions" value="[stop]"/>
       <remap from="cmd_vel" to="/base/cmd_vel"/>
+      <remap from="nav_vel" to="planner/cmd_vel"/>
     </node>
   </group>
 </launch>
@@ -40,9 +42,11 @@ def test_a_namespaced_remapped_monitor_names_the_topics_it_uses_and_reads_a_list
         ros.wait_service("/robot4/rubass/reset", launch, timeout=30)
         rec = ros.probe({"listen": [{"topic": "/robot4/rubass/events", "type": "std_msgs/String"},
                                     {"topic": "/diagnostics", "type": "diagnostic_msgs/DiagnosticArray"}],
-                         "advertise": [{"topic": "/base/cmd_vel", "type": "geometry_msgs/Twist"}],
-                         "steps": [{"wait_subscribers": "/base/cmd_vel"}, {"sleep": 1.2},
-                                   {"publish": "/base/cmd_vel", "msg": {"linear": {"x": 2.0}}},
+                         "advertise": [{"topic": "/base/cmd_vel", "type": "geometry_msgs/Twist"},
+                                       {"topic": "/robot4/planner/cmd_vel", "type": "std_msgs/String"}],
+                         "steps": [{"wait_subscribers": "/base/cmd_vel"}, {"wait_subscribers": "/robot4/planner/cmd_vel"},
+                                   {"sleep": 1.2}, {"publish": "/base/cmd_vel", "msg": {"linear": {"x": 2.0}}},
+                                   {"publish": "/robot4/planner/cmd_vel", "msg": {"data": "x"}},
                                    {"wait": "/robot4/rubass/events", "timeout": 5}, {"sleep": 2.5}]})
         log = ros.log(launch)
         assert "FATAL" not in log and "names [stop]" not in log, log  # "~overload_actions names [stop], which …" before
@@ -53,6 +57,8 @@ def test_a_namespaced_remapped_monitor_names_the_topics_it_uses_and_reads_a_list
         assert values.get("odd unknown because") == "no message on /robot4/odom (odom in the spec) yet", values
         # the stop reaches no one: said of the topic it is published on
         assert "no node subscribes to /robot4/safety_cmd (safety_cmd in the action library)" in log, log
+        assert ("/robot4/planner/cmd_vel (nav_vel in the action library) carries std_msgs/String, not "
+                "geometry_msgs/Twist") in log, log  # the limit's input, remapped
         assert "Traceback" not in log
     finally:
         launch.send_signal(signal.SIGINT)

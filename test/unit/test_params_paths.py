@@ -119,3 +119,49 @@ def test_status_and_events_name_the_topic_the_monitor_subscribes_to():
     d = Dispatcher({}, records.append, lambda: 1.0, {"cmd_vel": "/base/cmd_vel"}.get)
     d.report_event(Event(1.0, "start", 1), spec.behaviours[0], ("e.fast",), Message("cmd_vel", 1.0, None, 1.0, 0))
     assert records[-1]["cause"] == "message on /base/cmd_vel", records
+
+
+def test_an_absolute_or_package_path_needs_no_working_directory(tmp_path, monkeypatch):
+    """A re-sweep: started in a folder since removed, the monitor refused an absolute ~spec as relative."""
+    pkg = _package(tmp_path, monkeypatch)
+
+    def gone():
+        raise FileNotFoundError(2, "No such file or directory")
+
+    monkeypatch.setattr(os, "getcwd", gone)
+    config = _config(spec=str(pkg / "safety" / "s.rbs"), actions=["package://my_robot/safety/lib.yaml"])
+    assert config.spec == str(pkg / "safety" / "s.rbs") and config.relative == ()
+    with pytest.raises(ParamError) as err:
+        _config(spec="s.rbs")
+    assert "'s.rbs' is relative, and the monitor's working directory no longer exists" in str(err.value)
+
+
+def test_a_data_error_names_the_topic_the_monitor_reads():
+    spec = check_text("action primitive stop;\nentity e { rules: fast: topic cmd_vel.linear.x > 1 m/s; }\n"
+                      "if (e.fast) then { stop; }\n",
+                      extra_libraries=[os.path.join(os.path.dirname(__file__), "..", "..", "config", "fig2_actions.yaml")])
+    errors = {("cmd_vel", "('linear', 'x')"): "std_msgs/String has no field 'linear'"}
+    topics = {"cmd_vel": {"messages": 3, "errors": [], "resolved": "/base/cmd_vel"}}
+    assert unknown_reasons(spec, "e.fast", topics, {}, errors) == [
+        "rule 'e.fast' reads cmd_vel.linear.x (on /base/cmd_vel): std_msgs/String has no field 'linear'"]
+    topics["cmd_vel"]["resolved"] = "/cmd_vel"  # at the root: only the '/'
+    assert unknown_reasons(spec, "e.fast", topics, {}, errors) == [
+        "rule 'e.fast' reads /cmd_vel.linear.x: std_msgs/String has no field 'linear'"]
+
+
+def test_commands_and_test_files_take_package_paths(tmp_path, monkeypatch, capsys):
+    """A re-sweep: `rubass check package://…` said "no such file" of a file that exists, and a test file's
+    `spec:`/`actions:` made it `<dir>/package:/…`."""
+    from rubass.cli import main
+
+    pkg = _package(tmp_path, monkeypatch)
+    (pkg / "safety" / "t.test.yaml").write_text(
+        "spec: package://my_robot/safety/s.rbs\nactions: [package://my_robot/safety/lib.yaml]\ntests:\n"
+        "  - name: starts\n    duration: 1 s\n    expect:\n      - {at: 0 s, start: 1}\n")
+    monkeypatch.chdir(tmp_path)
+    assert main(["check", "package://my_robot/safety/s.rbs", "--actions", "package://my_robot/safety/lib.yaml"]) == 0
+    assert main(["test", str(pkg / "safety" / "t.test.yaml")]) == 0, capsys.readouterr()
+    capsys.readouterr()
+    assert main(["check", "package://nope/s.rbs"]) == 1
+    err = capsys.readouterr().err
+    assert "package://nope/s.rbs: error: cannot read spec: ROS package 'nope' not found on ROS_PACKAGE_PATH" in err, err

@@ -22,7 +22,7 @@ from ...actions.clamp import AXES, clamp_twist
 from ..reach import Reach
 from .arbiter import take_seat
 from ...actions.base import ActionPlugin, Context, Skipped
-from ...actions.status import NOTHING_DONE, RESOLVED
+from ...actions.status import NOTHING_DONE, RESOLVED, topic_shown
 from .publish import ros_class
 
 LOG_EVERY = 5.0
@@ -63,12 +63,16 @@ class LimitPlugin(ActionPlugin):
         self.input = rospy.resolve_name(self.params["input"])
         self.sub = rospy.Subscriber(self.params["input"], rospy.AnyMsg, self._on_input, tcp_nodelay=True)
 
+    def _input_shown(self) -> str:
+        """The input topic as the robot names it (namespace, remapping), the library's spelling beside."""
+        return topic_shown(self.params["input"], self.input, "the action library")
+
     # -- the subscriber's thread -----------------------------------------------------------
     def _on_input(self, raw: Any) -> None:
         now = time.monotonic()
         got = raw._connection_header.get("type", "")
         if got != self.type:
-            self._fail(f"{self.params['input']} carries {got}, not {self.type} as action '{self.name}' says: "
+            self._fail(f"{self._input_shown()} carries {got}, not {self.type} as action '{self.name}' says: "
                        f"its commands are ignored (so after {self.timeout:g} s it publishes zero)")
             return
         _LATEST[(self.input, self.type)] = (raw._buff, now)
@@ -148,7 +152,7 @@ class LimitPlugin(ActionPlugin):
             msg = self.cls().deserialize(buff)
         except Exception as exc:  # genpy.DeserializationError, struct.error: a broken publisher
             self._raw = None
-            self._fail(f"a command on {self.params['input']} cannot be read ({exc.__class__.__name__}: {exc}): "
+            self._fail(f"a command on {self._input_shown()} cannot be read ({exc.__class__.__name__}: {exc}): "
                        f"ignored")
             return None
         clamp_twist(msg.twist if self.stamped else msg, self.ranges)
