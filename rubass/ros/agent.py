@@ -46,7 +46,7 @@ from .agentbook import AGENT_TOPIC, STALE_PERIODS, encode, is_loopback, node_ent
 from .nodes import NodeSampler, NodeStatus
 from .params import ParamError, read_rate, unknown_params
 from .exiting import exit_within
-from .startup import init_node, wants_help
+from .startup import init_node, stop_asked, wants_help
 
 Log = Callable[[str, str], None]
 SAMPLE_WAIT = 0.5  # periods: how long a report waits for the samples it started (a hung node's never ends in time)
@@ -281,6 +281,8 @@ def main(argv: Optional[List[str]] = None) -> int:
     # good to unregister from a master that does not answer (a cut link), and never leaves the loop
     for sig in (signal.SIGINT, signal.SIGTERM):
         signal.signal(sig, lambda signum, frame: stop.set())
+    if stop_asked():  # one came between init_node and the lines above
+        stop.set()
     keep_rosout_flag()  # no log call asks the master anything (one would block while its host is cut off)
     try:
         names = rospy.get_param_names()

@@ -78,7 +78,6 @@ from .gcfreeze import freeze_heap
 from .timerslack import exact_timers
 from .priority import describe, thread_nice_values
 from .exiting import EXIT_GRACE, exit_within
-from .startup import EARLY_SIGHUP
 from .reloading import ConfigError, Reloading, StartupError
 from .topics import TopicWatcher, ros_now
 
@@ -105,7 +104,7 @@ class Monitor(Reloading):
         self._exit = threading.Event()
         self._starting = False  # setup() runs: a reload asked meanwhile waits for its end (_reload_deferred)
         self._start_lock = threading.Lock()
-        self._reload_deferred = False
+        self._reload_deferred = ""  # what asked for it ("SIGHUP", "service")
         self.spec: Optional[CheckedSpec] = None  # None while not enforcing (no usable spec yet)
         self.runners: Dict[str, ActionRunner] = {}
         self.retired_failures = 0  # failed attempts of runners a reload replaced: `failed action attempts` is since start
@@ -185,25 +184,30 @@ class Monitor(Reloading):
         # (after rospy's own handler, publish() silently does nothing); one while the spec is read (a
         # large one takes a second) ends the monitor once it is read, unregistered from the master
         for sig in (signal.SIGINT, signal.SIGTERM):
-            signal.signal(sig, lambda signum, frame: self._exit.set())
-        EARLY_SIGHUP.loading()  # a SIGHUP from now on may come after the file was read: reloaded below
-        self._starting = True  # a reload asked from now until enforcement begins is run after it
+            signal.signal(sig, self.request_stop)
+        # SIGHUP and ~reload before the spec is read: one asked while it is read, or while the monitor
+        # waits for the first /clock, is run as soon as it enforces (the file may have changed since)
+        self._starting = True
+        self._install_control()
         try:
             spec, runners = self.load()
         except ConfigError:
             raise
         except StartupError as exc:
             self._not_enforcing(str(exc))
-        self._install_control()
         freeze_heap()  # the one long collection (15-18 ms here), before anything is enforced (gcfreeze.py)
         if not self.load_error and not self._exit.is_set():
             self._enforce(spec, runners)
             freeze_heap()  # the engine, subscriptions and runners too: a short collection now
         with self._start_lock:
             self._starting = False
-            again = self._reload_deferred or EARLY_SIGHUP.pending
-        if again:  # a SIGHUP or ~reload came after the spec was read: the file may have changed since
-            self.request_reload()
+            asked = self._reload_deferred
+        if asked and not self._exit.is_set():
+            self.request_reload(f"{asked}, asked while the monitor started")
+
+    def request_stop(self, signum: int = 0, frame: object = None) -> None:
+        """Stop the monitor (SIGINT, SIGTERM): actions released on the main thread, which run() ends."""
+        self._exit.set()
 
     def _not_enforcing(self, error: str) -> None:
         self.load_error = error

@@ -16,7 +16,7 @@ from .monitor import ConfigError, Monitor
 from .params import HELP, ParamError, read_config, unknown_params
 from .priority import set_nice
 from .rosout_param import keep_rosout_flag
-from .startup import EARLY_SIGHUP, init_node, wants_help
+from .startup import init_node, stop_asked, wants_help
 
 USAGE = ("usage: rosrun rubass monitor _spec:=SPEC.rbs [_actions:=LIBRARY.yaml] [_NAME:=VALUE ...]\n"
          "The rubass monitor node: enforces the rules of SPEC on the live system until stopped (SIGINT/SIGTERM);\n"
@@ -24,14 +24,22 @@ USAGE = ("usage: rosrun rubass monitor _spec:=SPEC.rbs [_actions:=LIBRARY.yaml] 
          + HELP + "Check a spec first with: rubass check SPEC.rbs --actions LIBRARY.yaml\n")
 
 
-early_sighup = EARLY_SIGHUP  # SIGHUP until the monitor's own handler (startup.EarlySighup)
+_EARLY_SIGHUP = b"rubass: SIGHUP before the monitor started: nothing to reload yet (the spec is read when it starts)\n"
+
+
+def early_sighup(signum: int, frame: object) -> None:
+    """SIGHUP while the monitor waits for the master: said, nothing else (os.write: see main). Its own
+    handler is in place before it reads the spec (Monitor.setup)."""
+    os.write(2, _EARLY_SIGHUP)
 
 
 def main(argv: Optional[List[str]] = None) -> int:
     if wants_help(argv):
         sys.stdout.write(USAGE)
         return 0
-    # SIGHUP reloads once the monitor runs (its handler replaces this one); before, its default would end it
+    # SIGHUP reloads once the monitor runs (its handler replaces this one); before, its default would end it.
+    # os.write, not sys.stderr: a signal that lands inside a write to sys.stderr (the "waiting for the
+    # ROS master" line) would make that write reentrant, a RuntimeError that ended the process
     signal.signal(signal.SIGHUP, early_sighup)
     code = init_node("rubass", argv, lambda text: sys.stderr.write(f"rubass: {text}\n"))
     if code is not None:
@@ -65,7 +73,9 @@ def main(argv: Optional[List[str]] = None) -> int:
             rospy.loginfo("rubass: running at nice %d (~nice)", config.nice)
         monitor = Monitor(config)
         monitor.nice_refused = bool(refused)
-        monitor.setup()
+        monitor.setup()  # its SIGINT/SIGTERM handlers replace init_node's, which only note a signal
+        if stop_asked():  # one came before: it stops now, as its own handlers would have it
+            monitor.request_stop()
     except (ParamError, ConfigError) as exc:
         rospy.logfatal("rubass: cannot start:\n%s", exc)  # on stderr and in rosout: printed once
         rospy.signal_shutdown("cannot start")

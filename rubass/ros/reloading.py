@@ -52,12 +52,15 @@ class Reloading:
     _reload_wanted: threading.Event
     _starting: bool
     _start_lock: threading.Lock
-    _reload_deferred: bool
+    _reload_deferred: str
+    _exit: threading.Event
+    _reload_reason: str = "SIGHUP"  # what asked for the reload the reload thread runs next
 
-    def request_reload(self) -> None:
+    def request_reload(self, reason: str = "SIGHUP") -> None:
         """From the SIGHUP handler: wake the reload thread. A request that arrives while another
         waits behind the running reload is coalesced into it: that one reads the newest files
-        anyway, so a storm of SIGHUPs costs at most two reloads."""
+        anyway, so a storm of SIGHUPs costs at most two reloads. `reason`: what the log says asked."""
+        self._reload_reason = reason
         if self._reload_wanted.is_set():
             self.coalesced += 1
         self._reload_wanted.set()
@@ -68,23 +71,27 @@ class Reloading:
         while True:
             self._reload_wanted.wait()
             self._reload_wanted.clear()
+            reason, self._reload_reason = self._reload_reason, "SIGHUP"
             try:
-                self.reload("SIGHUP")
+                self.reload(reason)
             except queue.Empty:
-                rospy.logerr("rubass: reload (SIGHUP): the engine's thread did not take the new rules within "
-                             "its timeout (stalled?); the swap may still happen when it answers")
+                rospy.logerr("rubass: reload (%s): the engine's thread did not take the new rules within "
+                             "its timeout (stalled?); the swap may still happen when it answers", reason)
             except Exception as exc:  # noqa: BLE001 - the next SIGHUP must still be served
-                rospy.logerr("rubass: reload (SIGHUP) failed: %s: %s", exc.__class__.__name__, exc)
+                rospy.logerr("rubass: reload (%s) failed: %s: %s", reason, exc.__class__.__name__, exc)
 
     def reload(self, reason: str) -> Tuple[bool, str]:
         """Re-read spec and libraries; swap atomically, or keep the old rules on any error."""
         with self._start_lock:
-            if self._starting:  # the spec was read, enforcement not begun: once it is, read again (setup)
-                self._reload_deferred = True
+            if self._starting:  # the spec may be read, enforcement not begun: once it is, read again (setup)
+                self._reload_deferred = ", ".join(dict.fromkeys([r for r in self._reload_deferred.split(", ") if r]
+                                                                + [reason]))
                 rospy.loginfo("rubass: reload (%s) asked while the monitor starts: it reads the spec again as "
                               "soon as it enforces", reason)
                 return False, ("the monitor is still starting (reading its spec, or waiting for the first "
                                "/clock): it reads the spec again as soon as it enforces")
+        if self._exit.is_set():
+            return False, "the monitor is stopping"
         with self._reload_lock:
             t0 = time.monotonic()
             try:
@@ -94,6 +101,8 @@ class Reloading:
                 self._check_running_types(spec)
                 self._check_live_types(spec)
                 t_check = time.monotonic()
+                if self.spec is not None and self.loop is None:  # stopped before it enforced
+                    raise StartupError(f"not enforcing: {self._why_not()}")
                 if self.spec is None:  # not enforcing yet: this spec is the first usable one
                     self._enforce(spec, self._runners(spec, {}))
                     self.reloads += 1

@@ -2,7 +2,6 @@
 that is not up yet, which SIGINT or SIGTERM must end with one line, not a traceback."""
 from __future__ import annotations
 
-import os
 import signal
 import sys
 import time
@@ -15,31 +14,6 @@ class _Stopped(BaseException):
     """A signal ended the wait for the master: a BaseException, so that rospy's `except Exception`
     around its retries lets it through."""
 
-
-class EarlySighup:
-    """The SIGHUP handler before the monitor's own: while the node waits for the master nothing has been
-    read, so a SIGHUP is only said; once the monitor reads its spec (`loading()`), one may come after the
-    file was read, so it is noted (`pending`) and the monitor reloads as soon as its own handler is in
-    place (it was dropped: an edit saved then was never enforced). os.write, not sys.stderr: a signal
-    that lands inside a write to sys.stderr would make that write reentrant (a RuntimeError)."""
-
-    def __init__(self) -> None:
-        self.reading = False
-        self.pending = False
-
-    def loading(self) -> None:
-        self.reading, self.pending = True, False
-
-    def __call__(self, signum: int, frame: object) -> None:
-        if self.reading:
-            self.pending = True
-            os.write(2, b"rubass: SIGHUP while the monitor starts: it reads the spec again once it runs\n")
-        else:
-            os.write(2, b"rubass: SIGHUP before the monitor started: nothing to reload yet (the spec is read when "
-                        b"it starts)\n")
-
-
-EARLY_SIGHUP = EarlySighup()
 
 STOP_GRACE = 1.0  # s: nothing was started, so rospy gets this long to shut down before the process exits
 
@@ -89,7 +63,8 @@ def wants_help(argv: Optional[List[str]]) -> bool:
 
 def init_node(name: str, argv: Optional[List[str]], say: Callable[[str], None]) -> Optional[int]:
     """rospy.init_node, after waiting for the master as long as it does not answer. None once the node
-    is up (without rospy's SIGINT/SIGTERM handlers: the node installs its own); else the exit code, after `say` has told why: 0 when SIGINT or SIGTERM ended the wait,
+    is up (without rospy's SIGINT/SIGTERM handlers: until the node installs its own, one is noted for
+    stop_asked()); else the exit code, after `say` has told why: 0 when SIGINT or SIGTERM ended the wait,
     1 when the master went away during the start. rospy is then shut down, and the process exits within
     STOP_GRACE seconds even if rospy's shutdown waits for the master."""
     import rosgraph
@@ -123,9 +98,10 @@ def init_node(name: str, argv: Optional[List[str]], say: Callable[[str], None]) 
         failed = (f"cannot start: {', '.join('~' + n for n in nulls)}: null is no parameter value (the master "
                   f"cannot store it); leave the parameter out for its default" if nulls else f"cannot start: {exc}")
     finally:
-        for s, handler in previous.items():
-            signal.signal(s, handler)
-    if not (stopped or failed or rospy.is_shutdown()):
+        up = not (stopped or failed or rospy.is_shutdown())
+        for s, handler in previous.items():  # up: noted until the node's own (the imports' would exit
+            signal.signal(s, _ask_stop if up else handler)  # at once, its registrations left on the master)
+    if up:
         keep_console_log()
         return None
     say(failed or (f"stopped while starting (the ROS master at {uri} had answered); nothing was enforced" if answered
@@ -150,6 +126,19 @@ def master_answers(uri: str) -> bool:
     except Exception:  # noqa: BLE001 - refused, timed out, a bad URI or answer: not up (a signal's BaseException passes)
         return False
     return code == 1
+
+
+_ASKED: List[int] = []  # SIGINT/SIGTERM after the node is up, before it installed its own handlers
+
+
+def _ask_stop(signum: int, _frame: object) -> None:
+    _ASKED.append(signum)
+
+
+def stop_asked() -> bool:
+    """Whether SIGINT or SIGTERM came between init_node's return and the node's own handlers: the node
+    stops as soon as those are in place (cleanly: released, unregistered)."""
+    return bool(_ASKED)
 
 
 def _wait_for_master(uri: str, say: Callable[[str], None], stopped: List[int]) -> None:

@@ -100,3 +100,22 @@ def test_sighups_are_served_by_one_thread_that_coalesces_a_storm_and_outlives_a_
     assert logged == ["rubass: reload (SIGHUP) failed: RuntimeError: a bug in a reload"]
     monitor.request_reload()  # the thread serves the next SIGHUP
     assert wait_for(3) == 3 and calls == [("SIGHUP", "rubass-reload")] * 3
+
+
+def test_a_reload_asked_while_the_monitor_starts_is_noted_with_what_asked_it():
+    """A re-sweep: `~reload` while the spec was read did not exist yet, and one asked while the monitor
+    waited for /clock was run on an engine that did not exist. While it starts, a reload is noted (setup
+    runs it once it enforces, labelled with what asked it) and reads nothing; once it stops, none runs."""
+    import threading
+
+    monitor = FakeMonitor(None)
+    monitor._starting, monitor._start_lock, monitor._reload_deferred = True, threading.Lock(), ""
+    monitor._exit = threading.Event()
+    ok, text = monitor.reload("service")
+    assert not ok and "still starting" in text and "as soon as it enforces" in text
+    monitor.reload("SIGHUP")
+    monitor.reload("service")
+    assert monitor._reload_deferred == "service, SIGHUP"
+    monitor._starting = False
+    monitor._exit.set()
+    assert monitor.reload("SIGHUP") == (False, "the monitor is stopping")
