@@ -95,27 +95,29 @@ def test_a_paused_master_gets_the_waiting_line_and_the_monitor_enforces_once_it_
     assert _speed_brakes(ros, 2.0), ros.log(mon)
 
 
+def _started_with(code):
+    """Run `code` in a process where the master answered (no master needed) and startup is imported."""
+    head = ("import os, signal, sys, time\nimport rospy\nimport rubass.ros.startup as startup\n"
+            "startup.master_answers = lambda uri: True  # it answered\n")
+    env = dict(os.environ, ROS_MASTER_URI="http://127.0.0.1:1", PYTHONDONTWRITEBYTECODE="1")
+    return subprocess.run([sys.executable, "-c", head + code], cwd=ROOT, env=env, capture_output=True, text=True,
+                          timeout=30)
+
+
 def test_a_signal_after_rospys_start_before_the_nodes_own_handlers_is_kept_for_them():
     """A re-sweep: in the few ms after init_node, the imports' handler ran (exit 143 at once, "stopped while
     loading", the node's registrations left on the master)."""
-    code = ("import os, signal, sys\nimport rospy\nimport rubass.ros.startup as startup\n"
-            "startup.master_answers = lambda uri: True\nrospy.init_node = lambda *a, **k: None\n"
-            "signal.signal(signal.SIGTERM, lambda s, f: sys.exit(143))  # as scripts/monitor has it\n"
-            "assert startup.init_node('probe', ['probe'], print) is None\n"
-            "os.kill(os.getpid(), signal.SIGTERM)\nprint('alive', startup.stop_asked())\n")
-    env = dict(os.environ, ROS_MASTER_URI="http://127.0.0.1:1", PYTHONDONTWRITEBYTECODE="1")
-    out = subprocess.run([sys.executable, "-c", code], cwd=ROOT, env=env, capture_output=True, text=True, timeout=30)
+    out = _started_with("rospy.init_node = lambda *a, **k: None\n"
+                        "signal.signal(signal.SIGTERM, lambda s, f: sys.exit(143))  # as scripts/monitor has it\n"
+                        "assert startup.init_node('probe', ['probe'], print) is None\n"
+                        "os.kill(os.getpid(), signal.SIGTERM)\nprint('alive', startup.stop_asked())\n")
     assert (out.returncode, out.stdout) == (0, "alive True\n"), (out.stdout, out.stderr)
 
 
 def test_a_signal_during_rospys_own_start_does_not_say_the_master_never_answered():
-    code = ("import os, signal, sys, time\nimport rospy\nimport rubass.ros.startup as startup\n"
-            "startup.master_answers = lambda uri: True  # it answered\n"
-            "def init_node(*a, **k):\n    os.kill(os.getpid(), signal.SIGTERM)\n    time.sleep(0.05)\n"
-            "rospy.init_node = init_node\n"
-            "sys.exit(startup.init_node('probe', ['probe'], lambda t: sys.stderr.write(t + '\\n')))\n")
-    env = dict(os.environ, ROS_MASTER_URI="http://127.0.0.1:1", PYTHONDONTWRITEBYTECODE="1")
-    out = subprocess.run([sys.executable, "-c", code], cwd=ROOT, env=env, capture_output=True, text=True, timeout=30)
+    out = _started_with("def init_node(*a, **k):\n    os.kill(os.getpid(), signal.SIGTERM)\n    time.sleep(0.05)\n"
+                        "rospy.init_node = init_node\n"
+                        "sys.exit(startup.init_node('probe', ['probe'], lambda t: sys.stderr.write(t + '\\n')))\n")
     assert out.returncode == 0, out.stderr
     assert "stopped while starting (the ROS master at http://127.0.0.1:1 had answered); nothing was enforced" \
         in out.stderr, out.stderr
