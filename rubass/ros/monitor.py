@@ -185,16 +185,18 @@ class Monitor(Reloading):
         # large one takes a second) ends the monitor once it is read, unregistered from the master
         for sig in (signal.SIGINT, signal.SIGTERM):
             signal.signal(sig, self.request_stop)
-        # SIGHUP and ~reload before the spec is read: one asked while it is read, or while the monitor
-        # waits for the first /clock, is run as soon as it enforces (the file may have changed since)
+        # SIGHUP before the spec is read: one that comes while it is read, or a SIGHUP or ~reload while the
+        # monitor waits for the first /clock, is run as soon as it enforces (the file may have changed)
         self._starting = True
-        self._install_control()
+        threading.Thread(target=self.reload_thread, name="rubass-reload", daemon=True).start()
+        signal.signal(signal.SIGHUP, lambda signum, frame: self.request_reload())
         try:
             spec, runners = self.load()
         except ConfigError:
             raise
         except StartupError as exc:
             self._not_enforcing(str(exc))
+        self._install_control()  # the services once the spec is read, as before: ~reset up means read
         freeze_heap()  # the one long collection (15-18 ms here), before anything is enforced (gcfreeze.py)
         if not self.load_error and not self._exit.is_set():
             self._enforce(spec, runners)
@@ -310,13 +312,11 @@ class Monitor(Reloading):
         threading.Thread(target=self._engine_thread, name="rubass-engine", daemon=True).start()
 
     def _install_control(self) -> None:
-        """Services, signals and the master watch: up whether or not the spec can be enforced."""
+        """Services and the master watch: up whether or not the spec can be enforced."""
         self.master_watch = MasterWatch(rospy.get_caller_id(), rospy.core.get_node_uri(), rosgraph.get_master_uri(),
                                         1.0 / self.config.master_rate, _log)
         rospy.Service("~reload", Trigger, lambda req: TriggerResponse(*self.reload("service")))
         rospy.Service("~reset", Trigger, lambda req: TriggerResponse(*self.reset()))
-        threading.Thread(target=self.reload_thread, name="rubass-reload", daemon=True).start()
-        signal.signal(signal.SIGHUP, lambda signum, frame: self.request_reload())
         self.master_watch.start()
 
     def _withhold(self, spec: CheckedSpec) -> None:

@@ -59,7 +59,8 @@ def test_an_edit_saved_and_signalled_while_the_spec_is_read_is_enforced(ros, tmp
     spec = tmp_path / "s.rbs"
     _big_spec(spec, 100)  # lenient
     mon = ros.monitor(str(spec), wait=False)
-    ros.wait_service("/rubass/reload", mon, timeout=30)  # there before the spec is read (about a second)
+    _wait_registered(ros, mon)
+    time.sleep(0.1)  # reading the spec now (about a second)
     _big_spec(spec, 1)  # the engineer's stricter edit, saved, then SIGHUP
     mon.send_signal(signal.SIGHUP)
     rosharness.wait_log(mon, ros, "rubass: enforcing", timeout=30)
