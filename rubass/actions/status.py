@@ -58,10 +58,11 @@ def unknown_reasons(spec: CheckedSpec, rule_key: str, topics: Dict[str, Dict[str
                 why.append(err)
             fe = field_errors.get((e.topic, str(e.path)))
             if fe:
-                resolved = t.get("resolved")
-                shown = topic_shown(e.topic, resolved)
-                on = "" if shown in (e.topic, resolved) else f" (on {resolved})"  # in a namespace, remapped
-                why.append(f"rule '{rule_key}' reads {shown if not on else e.topic}{ast.path_suffix(e.path)}{on}: {fe}")
+                resolved, field = t.get("resolved") or e.topic, ast.path_suffix(e.path)
+                if topic_shown(e.topic, resolved) in (e.topic, resolved):  # one name, or a leading '/' more
+                    why.append(f"rule '{rule_key}' reads {resolved}{field}: {fe}")
+                else:  # moved by a namespace or a remap
+                    why.append(f"rule '{rule_key}' reads {e.topic}{field} (on {resolved}): {fe}")
         elif isinstance(e, _NODE_REFS):
             n = nodes.get(e.node)
             if n is not None and n.get("why") not in (None, "alive"):

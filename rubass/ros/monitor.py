@@ -104,7 +104,7 @@ class Monitor(Reloading):
         self._exit = threading.Event()
         self._starting = False  # setup() runs: a reload asked meanwhile waits for its end (_reload_deferred)
         self._start_lock = threading.Lock()
-        self._reload_deferred = ""  # what asked for it ("SIGHUP", "service")
+        self._reload_deferred: List[str] = []  # what asked for it ("SIGHUP", "service")
         self.spec: Optional[CheckedSpec] = None  # None while not enforcing (no usable spec yet)
         self.runners: Dict[str, ActionRunner] = {}
         self.retired_failures = 0  # failed attempts of runners a reload replaced: `failed action attempts` is since start
@@ -203,7 +203,7 @@ class Monitor(Reloading):
             freeze_heap()  # the engine, subscriptions and runners too: a short collection now
         with self._start_lock:
             self._starting = False
-            asked = self._reload_deferred
+            asked = ", ".join(self._reload_deferred)
         if asked and not self._exit.is_set():
             self.request_reload(f"{asked}, asked while the monitor started")
 

@@ -52,7 +52,7 @@ class Reloading:
     _reload_wanted: threading.Event
     _starting: bool
     _start_lock: threading.Lock
-    _reload_deferred: str
+    _reload_deferred: List[str]
     _exit: threading.Event
     _reload_reason: str = "SIGHUP"  # what asked for the reload the reload thread runs next
 
@@ -84,8 +84,8 @@ class Reloading:
         """Re-read spec and libraries; swap atomically, or keep the old rules on any error."""
         with self._start_lock:
             if self._starting:  # the spec may be read, enforcement not begun: once it is, read again (setup)
-                self._reload_deferred = ", ".join(dict.fromkeys([r for r in self._reload_deferred.split(", ") if r]
-                                                                + [reason]))
+                if reason not in self._reload_deferred:
+                    self._reload_deferred.append(reason)
                 rospy.loginfo("rubass: reload (%s) asked while the monitor starts: it reads the spec again as "
                               "soon as it enforces", reason)
                 return False, ("the monitor is still starting (reading its spec, or waiting for the first "

@@ -109,13 +109,13 @@ def test_a_reload_asked_while_the_monitor_starts_is_noted_with_what_asked_it():
     import threading
 
     monitor = FakeMonitor(None)
-    monitor._starting, monitor._start_lock, monitor._reload_deferred = True, threading.Lock(), ""
+    monitor._starting, monitor._start_lock, monitor._reload_deferred = True, threading.Lock(), []
     monitor._exit = threading.Event()
     ok, text = monitor.reload("service")
     assert not ok and "still starting" in text and "as soon as it enforces" in text
     monitor.reload("SIGHUP")
     monitor.reload("service")
-    assert monitor._reload_deferred == "service, SIGHUP"
+    assert monitor._reload_deferred == ["service", "SIGHUP"]
     monitor._starting = False
     monitor._exit.set()
     assert monitor.reload("SIGHUP") == (False, "the monitor is stopping")
