@@ -20,7 +20,7 @@ Report = Callable[[Dict[str, Any]], None]
 class Dispatcher:
     def __init__(self, runners: Dict[str, ActionRunner], report: Report, ros_now: Callable[[], float],
                  topic_name: Callable[[str], str] = str) -> None:
-        """`topic_name`: the name a spec's topic has on the robot (namespace and remappings applied),
+        """`topic_name`: the name a spec's topic or node has on the robot (namespace and remappings applied),
         as a start's `cause` names it."""
         self.runners = runners
         self.report = report
@@ -77,7 +77,7 @@ class Dispatcher:
         if isinstance(cause, Message) and cause.received:
             source, latency = f"message on {self.topic_name(cause.topic)}", time.time() - cause.received
         elif isinstance(cause, NodeSample):  # from the sample's instant, or the deadline it came with
-            source, latency = f"node sample of {cause.node}", max(0.0, self.ros_now() - e.time)
+            source, latency = f"node sample of {self.topic_name(cause.node)}", max(0.0, self.ros_now() - e.time)
         elif cause == "reset":
             source, latency = "reset service", None
         elif cause in ("reload", "shutdown"):

@@ -66,7 +66,7 @@ def unknown_reasons(spec: CheckedSpec, rule_key: str, topics: Dict[str, Dict[str
         elif isinstance(e, _NODE_REFS):
             n = nodes.get(e.node)
             if n is not None and n.get("why") not in (None, "alive"):
-                why.append(f"node {e.node}: {n['why']}")
+                why.append(f"node {topic_shown(e.node, n.get('resolved'))}: {n['why']}")
     return sorted(set(why))
 
 

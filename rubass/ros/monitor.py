@@ -475,7 +475,7 @@ class Monitor(Reloading):
         self.livecheck.note(self.watcher.carried_types())
         topics = {name: {"messages": s.messages, "errors": s.errors, "type": s.type, "resolved": s.resolved}
                   for s in self.watcher.status() for name in (s.spec_name,) + s.aliases}  # every spelling
-        nodes = {s.spec_name: {"why": s.why} for s in self.sampler.status.values()}
+        nodes = {s.spec_name: {"why": s.why, "resolved": s.resolved} for s in self.sampler.status.values()}
         failures = self.retired_failures + sum(r.stats.failures for r in self.runners.values())
         lat = sorted(self.dispatcher.latencies)
         monitor: Dict[str, Any] = {

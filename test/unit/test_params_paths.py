@@ -10,7 +10,7 @@ import pytest
 from rubass.actions.dispatch import Dispatcher
 from rubass.actions.status import topic_shown, unknown_reasons
 from rubass.engine.events import Event
-from rubass.engine.loop import Message
+from rubass.engine.loop import Message, NodeSample
 from rubass.lang import check_text, load_spec
 from rubass.lang.paths import clear_cache
 from rubass.ros.params import ParamError, read_config, relative_note
@@ -119,6 +119,22 @@ def test_status_and_events_name_the_topic_the_monitor_subscribes_to():
     d = Dispatcher({}, records.append, lambda: 1.0, {"cmd_vel": "/base/cmd_vel"}.get)
     d.report_event(Event(1.0, "start", 1), spec.behaviours[0], ("e.fast",), Message("cmd_vel", 1.0, None, 1.0, 0))
     assert records[-1]["cause"] == "message on /base/cmd_vel", records
+
+
+def test_status_and_events_name_a_node_as_the_robot_names_it():
+    """A sweep of namespaces: causes and unknown reasons named a node as the spec spelled it (`ctl`)
+    while the monitor sampled /robot1/ctl."""
+    spec = check_text("action primitive stop;\nentity e: ctl { rules: hot: cpu(node ctl) > 50 %; }\n"
+                      "if (e.hot) then { stop; }\n",
+                      extra_libraries=[os.path.join(os.path.dirname(__file__), "..", "..", "config", "fig2_actions.yaml")])
+    nodes = {"ctl": {"why": "the master cannot be reached (refused) and the node was never seen",
+                     "resolved": "/robot1/ctl"}}
+    assert unknown_reasons(spec, "e.hot", {}, nodes, {}) == [
+        "node /robot1/ctl (ctl in the spec): the master cannot be reached (refused) and the node was never seen"]
+    records = []
+    d = Dispatcher({}, records.append, lambda: 1.0, {"ctl": "/robot1/ctl"}.get)
+    d.report_event(Event(1.0, "start", 1), spec.behaviours[0], ("e.hot",), NodeSample("ctl", 1.0, True, 60.0, 0))
+    assert records[-1]["cause"] == "node sample of /robot1/ctl", records
 
 
 def test_an_absolute_or_package_path_needs_no_working_directory(tmp_path, monkeypatch):
