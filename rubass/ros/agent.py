@@ -46,7 +46,7 @@ from .agentbook import AGENT_TOPIC, STALE_PERIODS, encode, is_loopback, node_ent
 from .nodes import NodeSampler, NodeStatus
 from .params import ParamError, read_rate, unknown_params
 from .exiting import exit_within
-from .startup import init_node, stop_asked, wants_help
+from .startup import MasterLost, init_node, private_param, stop_asked, wants_help
 
 Log = Callable[[str, str], None]
 SAMPLE_WAIT = 0.5  # periods: how long a report waits for the samples it started (a hung node's never ends in time)
@@ -291,11 +291,14 @@ def main(argv: Optional[List[str]] = None) -> int:
     for warning in unknown_params(names, rospy.get_name(), AGENT_PARAMS):  # a typo must not pass silently
         rospy.logwarn("rubass agent: %s", warning)
     try:
-        get = lambda name, default: rospy.get_param("~" + name, default)  # noqa: E731
-        rate = read_rate(get, "node_rate", 10.0, 0.1, 100.0)
-        discover_period = 1.0 / read_rate(get, "discover_rate", 1.0, 0.01, 100.0)
+        rate = read_rate(private_param, "node_rate", 10.0, 0.1, 100.0)
+        discover_period = 1.0 / read_rate(private_param, "discover_rate", 1.0, 0.01, 100.0)
     except ParamError as exc:
         code = _refuse(str(exc), stop)
+        exit_within(EXIT_GRACE, code, AGENT_DONE)
+    except MasterLost as exc:  # as when it goes away during init_node: one line, exit 1
+        rospy.logfatal(f"rubass agent: cannot start: {exc}; nothing was reported")
+        code = 1
         exit_within(EXIT_GRACE, code, AGENT_DONE)
     else:
         code = _run(rate, discover_period, stop)

@@ -28,7 +28,7 @@ import threading
 import time
 import xmlrpc.client
 from dataclasses import dataclass
-from typing import Any, Callable, Optional, Tuple
+from typing import Any, Callable, Optional, Tuple, Union
 
 from rospy.impl.registration import RegManager, get_registration_listeners, get_service_manager, get_topic_manager
 
@@ -37,6 +37,8 @@ from . import rpc
 Log = Callable[[str, str], None]
 MONITOR_UNREACHABLE = ("existing connections keep working and the rules keep being enforced; nodes started now "
                        "cannot connect to the monitor until the master is back")
+MONITOR_STARTING_UNREACHABLE = ("the monitor is still starting and enforces nothing yet; what it registers with the "
+                                "master (its actions' publishers, its services) waits for the master to be back")
 
 
 @dataclass
@@ -85,8 +87,9 @@ class MasterWatch:
     forgotten it. `state` and the counters feed the monitor's /diagnostics."""
 
     def __init__(self, caller_id: str, node_uri: str, master_uri: str, period: float, log: Log,
-                 timeout: float = 0.5, unreachable: str = MONITOR_UNREACHABLE) -> None:
-        """`unreachable`: what the warning logged when the master stops answering says it means."""
+                 timeout: float = 0.5, unreachable: Union[str, Callable[[], str]] = MONITOR_UNREACHABLE) -> None:
+        """`unreachable`: what the warning logged when the master stops answering says it means (or a
+        function saying it then)."""
         self.caller_id, self.node_uri, self.master_uri = caller_id, node_uri, master_uri
         self.unreachable = unreachable
         self.period, self.timeout, self.log = period, timeout, log
@@ -128,7 +131,8 @@ class MasterWatch:
             # (its /rosout goes there) until the link is back, and /diagnostics must say it meanwhile
             self.state = f"unreachable for {time.monotonic() - self.down_since:.1f} s"
             if first:
-                self.log("warn", f"the master at {self.master_uri} cannot be reached ({exc}): {self.unreachable}")
+                means = self.unreachable() if callable(self.unreachable) else self.unreachable
+                self.log("warn", f"the master at {self.master_uri} cannot be reached ({exc}): {means}")
             return "unreachable"
         was_down, self.down_since = self.down_since, None
         was_pid, self.master_pid = self.master_pid, pid

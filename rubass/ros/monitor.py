@@ -63,7 +63,7 @@ from .agentbook import AGENT_TOPIC, AgentBook
 from .agentbook import decode as decode_agent_report
 from ..actions.runner import ActionRunner
 from ..actions.dispatch import Dispatcher
-from .master_watch import MasterWatch
+from .master_watch import MONITOR_STARTING_UNREACHABLE, MONITOR_UNREACHABLE, MasterWatch
 from .libtypes import after_check, render_failed_check
 from .livecheck import LiveTypeCheck
 from .nodes import NodeSampler
@@ -78,7 +78,7 @@ from .gcfreeze import freeze_heap
 from .timerslack import exact_timers
 from .priority import describe, thread_nice_values
 from .exiting import EXIT_GRACE, exit_within
-from .reloading import ConfigError, Reloading, StartupError
+from .reloading import ConfigError, Reloading, StartupError, said_if_slow
 from .topics import TopicWatcher, ros_now
 
 
@@ -123,7 +123,9 @@ class Monitor(Reloading):
         self._check_actions(spec)
         for w in spec_warnings(spec.warnings, self.config):
             rospy.logwarn("rubass: %s", w.render(spec.sources))
-        return spec, self._runners(spec, {})
+        with said_if_slow("rubass: setting up the actions waits for the master (a publisher or service registers "
+                          "with it): NO RULE IS ENFORCED until it answers"):
+            return spec, self._runners(spec, {})
 
     def _failed_text(self, exc: SpecError) -> str:
         """Every error of a spec that did not check, as `rubass check` prints them; where a relative
@@ -303,7 +305,9 @@ class Monitor(Reloading):
         self.watcher.sync(spec)
         self.livecheck = LiveTypeCheck(_log)  # the spec against the types its topics turn out to carry
         self.agents = AgentBook()  # cpu and memory of nodes on other hosts, from their agents
-        self._agent_sub = rospy.Subscriber(AGENT_TOPIC, String, self._on_agent, queue_size=100, tcp_nodelay=True)
+        # rospy waits for the master to register a subscription or a service (holding its lock): not here,
+        # where a master that went down while the spec was read would hold every rule unenforced
+        threading.Thread(target=self._subscribe_agents, name="rubass-agents", daemon=True).start()
         self.sampler = self._sampler(spec)
         self.load_error = ""
         rospy.loginfo("rubass: enforcing %s (%s)", spec.path, ", ".join(  # distinct topics
@@ -312,12 +316,34 @@ class Monitor(Reloading):
         threading.Thread(target=self._engine_thread, name="rubass-engine", daemon=True).start()
 
     def _install_control(self) -> None:
-        """Services and the master watch: up whether or not the spec can be enforced."""
+        """Services and the master watch: up whether or not the spec can be enforced. The services
+        register on a thread of their own: the start goes on while the master does not answer."""
         self.master_watch = MasterWatch(rospy.get_caller_id(), rospy.core.get_node_uri(), rosgraph.get_master_uri(),
-                                        1.0 / self.config.master_rate, _log)
-        rospy.Service("~reload", Trigger, lambda req: TriggerResponse(*self.reload("service")))
-        rospy.Service("~reset", Trigger, lambda req: TriggerResponse(*self.reset()))
+                                        1.0 / self.config.master_rate, _log, unreachable=self._unreachable_means)
         self.master_watch.start()
+        threading.Thread(target=self._advertise_services, name="rubass-services", daemon=True).start()
+
+    def _advertise_services(self) -> None:
+        try:
+            rospy.Service("~reload", Trigger, lambda req: TriggerResponse(*self.reload("service")))
+            rospy.Service("~reset", Trigger, lambda req: TriggerResponse(*self.reset()))
+        except Exception as exc:  # noqa: BLE001 - SIGHUP still reloads; the rules are enforced either way
+            _log("error", f"rubass: cannot offer ~reload and ~reset: {exc.__class__.__name__}: {exc}")
+
+    def _subscribe_agents(self) -> None:
+        try:
+            rospy.Subscriber(AGENT_TOPIC, String, self._on_agent, queue_size=100, tcp_nodelay=True)
+        except Exception as exc:  # noqa: BLE001 - the nodes of other hosts then read unknown, and say why
+            _log("error", f"rubass: cannot subscribe to {AGENT_TOPIC}: {exc.__class__.__name__}: {exc}")
+
+    def _unreachable_means(self) -> str:
+        """What a master that stops answering means for the robot, as the monitor stands."""
+        if self.loop is not None:
+            return MONITOR_UNREACHABLE
+        if self.load_error:
+            return ("NO RULE IS ENFORCED (the spec cannot be used, see above); nodes started now cannot connect to the "
+                    "monitor until the master is back")
+        return MONITOR_STARTING_UNREACHABLE
 
     def _withhold(self, spec: CheckedSpec) -> None:
         """A latch of the previous run on an action this spec does not declare cannot be held: the

@@ -11,12 +11,13 @@ import rosgraph
 import rospy
 
 from ..actions.latches import adopt_old_default, adopt_unkeyed, default_path, master_key
+from .exiting import exit_within
 from .latch_master import is_local
 from .monitor import ConfigError, Monitor
 from .params import HELP, ParamError, read_config, unknown_params
 from .priority import set_nice
 from .rosout_param import keep_rosout_flag
-from .startup import init_node, stop_asked, wants_help
+from .startup import STOP_GRACE, MasterLost, init_node, private_param, stop_asked, wants_help
 
 USAGE = ("usage: rosrun rubass monitor _spec:=SPEC.rbs [_actions:=LIBRARY.yaml] [_NAME:=VALUE ...]\n"
          "The rubass monitor node: enforces the rules of SPEC on the live system until stopped (SIGINT/SIGTERM);\n"
@@ -65,7 +66,7 @@ def main(argv: Optional[List[str]] = None) -> int:
             rospy.logwarn("rubass: latch state %s (kept by an earlier version for any master) copied to %s, "
                           "this master's", unkeyed, state_file)
     try:
-        config = read_config(lambda name, default: rospy.get_param("~" + name, default), state_file)
+        config = read_config(private_param, state_file)
         refused = set_nice(config.nice) if config.nice is not None else None  # before the monitor's threads
         if refused:  # start: they inherit it
             rospy.logwarn("rubass: %s", refused)
@@ -78,6 +79,11 @@ def main(argv: Optional[List[str]] = None) -> int:
             monitor.request_stop()
     except (ParamError, ConfigError) as exc:
         rospy.logfatal("rubass: cannot start:\n%s", exc)  # on stderr and in rosout: printed once
+        rospy.signal_shutdown("cannot start")
+        return 1
+    except MasterLost as exc:  # as when it goes away during init_node: one line, exit 1
+        rospy.logfatal("rubass: cannot start: %s; nothing was enforced", exc)
+        exit_within(STOP_GRACE, 1, "nothing had been started")  # rospy's shutdown may wait for the master
         rospy.signal_shutdown("cannot start")
         return 1
     monitor.run()

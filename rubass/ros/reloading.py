@@ -7,7 +7,8 @@ import os
 import queue
 import threading
 import time
-from typing import Any, Dict, List, Optional, Tuple
+from contextlib import contextmanager
+from typing import Any, Dict, Iterator, List, Optional, Tuple
 
 import rospy
 
@@ -29,6 +30,20 @@ class StartupError(RubassError):
 
 class ConfigError(StartupError):
     """The parameters do not fit the spec (~overload_actions): the monitor exits."""
+
+
+@contextmanager
+def said_if_slow(text: str, after: float = 1.0) -> Iterator[None]:
+    """Log `text` (WARN) if the block takes over `after` seconds: setting up actions registers their
+    publishers with the master, which rospy waits for without a word, and a wait that says nothing
+    looks like one that took effect."""
+    slow = threading.Timer(after, lambda: rospy.logwarn(text))
+    slow.daemon = True
+    slow.start()
+    try:
+        yield
+    finally:
+        slow.cancel()
 
 
 class Reloading:
@@ -127,15 +142,10 @@ class Reloading:
                                        f"(latch: false) while it is latched and active: the reload would release "
                                        f"the stop without ~reset; call ~reset first (once its cause is gone), then "
                                        f"reload")
-                slow = threading.Timer(1.0, lambda: rospy.logwarn(
-                    "rubass: reload (%s): setting up its new actions waits for the master (a new publisher or "
-                    "service registers with it); the previous rules keep running until it answers", reason))
-                slow.daemon = True
-                slow.start()  # a reload that waits silently looks like one that took effect
-                try:
+                with said_if_slow(f"rubass: reload ({reason}): setting up its new actions waits for the master (a "
+                                  f"new publisher or service registers with it); the previous rules keep running "
+                                  f"until it answers"):
                     runners = self._runners(spec, self.runners)
-                finally:
-                    slow.cancel()
             except (SpecError, StartupError) as exc:
                 text = self._failed_text(exc) if isinstance(exc, SpecError) else str(exc)
                 self.rejected += 1

@@ -5,7 +5,7 @@ from __future__ import annotations
 import signal
 import sys
 import time
-from typing import Callable, List, Optional
+from typing import Any, Callable, List, Optional
 
 from .exiting import exit_within
 
@@ -16,6 +16,23 @@ class _Stopped(BaseException):
 
 
 STOP_GRACE = 1.0  # s: nothing was started, so rospy gets this long to shut down before the process exits
+
+
+class MasterLost(Exception):
+    """The master stopped answering after init_node, while the node read its parameters (a traceback
+    before): the message says so, for a `cannot start:` line."""
+
+
+def private_param(name: str, default: Any) -> Any:
+    """rospy.get_param("~NAME", default); MasterLost when the master does not answer."""
+    import rosgraph
+    import rospy
+
+    try:
+        return rospy.get_param("~" + name, default)
+    except OSError as exc:
+        raise MasterLost(f"the ROS master at {rosgraph.get_master_uri()} stopped answering while the parameters "
+                         f"were read (~{name}: {exc.strerror or exc})") from None
 
 
 def keep_console_log() -> bool:

@@ -144,3 +144,56 @@ def test_sigint_while_waiting_for_the_first_clock_says_no_clock_came(ros, tmp_pa
     log = ros.log(mon)
     assert "first /clock message" not in log and "rubass: enforcing" not in log, log
     assert "stopping" in log and "Error" not in log and "previous rules" not in log, log
+
+
+LOG_LIB = """actions:
+  stop: {plugin: log, level: warn, message: STOP-LOGGED}
+  brake: {plugin: log, level: warn, message: BRAKE-LOGGED}
+  warn: {plugin: log, level: warn, message: WARN-LOGGED}
+"""
+
+
+def _stale_spec(path, rules=6000):
+    """A spec that takes about a second to read, with a watchdog needing no master: /cmd_vel silent for 1 s."""
+    lines = ['import "lib.yaml";', "action primitive stop, brake, warn;", "entity f { rules:"]
+    lines += [f"  r{i}: topic /filler{i % 50}.data > {i};" for i in range(rules)]
+    lines += ["}", "entity base { rules: stale: age(topic /cmd_vel) > 1 s; }", "if (base.stale) then { stop; }"]
+    path.write_text("\n".join(lines) + "\n")
+
+
+def test_a_master_lost_while_the_spec_is_read_does_not_hold_the_rules_unenforced(ros, tmp_path):
+    """CI found it: a master that went down in the monitor's start, after the spec was read, held the
+    start in rospy's registration of ~reload (and of the agents' topic) until the master came back: no
+    rule was enforced meanwhile, while the master watch said "the rules keep being enforced"."""
+    (tmp_path / "lib.yaml").write_text(LOG_LIB)
+    spec = tmp_path / "s.rbs"
+    _stale_spec(spec)
+    mon = ros.monitor(str(spec), wait=False)
+    _wait_registered(ros, mon)
+    time.sleep(0.3)  # the parameters are read (a few ms); the spec is being read (about a second)
+    ros.master.stop()
+    rosharness.wait_log(mon, ros, "rubass: enforcing", timeout=30)
+    rosharness.wait_log(mon, ros, "STOP-LOGGED", timeout=10)  # the watchdog, with the master still down
+    assert "the rules keep being enforced" not in ros.log(mon).split("rubass: enforcing")[0], ros.log(mon)
+    ros.master.restart()
+    ros.wait_service("/rubass/reset", mon, timeout=20)  # registered once the master is back
+    assert mon.poll() is None, ros.log(mon)
+
+
+def test_a_master_lost_before_the_actions_are_set_up_is_said_and_enforcing_follows_its_return(ros, tmp_path):
+    """Publish actions register with the master; while it is down the start waits there: said, with NO
+    RULE IS ENFORCED (rospy said only "Unable to register"), and enforcing follows the master's return."""
+    (tmp_path / "lib.yaml").write_text(rosharness.LIB)
+    spec = tmp_path / "s.rbs"
+    _big_spec(spec, 1)
+    mon = ros.monitor(str(spec), wait=False)
+    _wait_registered(ros, mon)
+    time.sleep(0.3)  # the parameters are read (a few ms); the spec is being read (about a second)
+    ros.master.stop()
+    rosharness.wait_log(mon, ros, "setting up the actions waits for the master", timeout=30)
+    log = ros.log(mon)
+    assert "NO RULE IS ENFORCED until it answers" in log and "rubass: enforcing" not in log, log
+    ros.master.restart()
+    rosharness.wait_log(mon, ros, "rubass: enforcing", timeout=30)
+    ros.wait_service("/rubass/reset", mon, timeout=20)
+    assert _speed_brakes(ros, 2.0), ros.log(mon)
