@@ -123,8 +123,9 @@ class Monitor(Reloading):
         self._check_actions(spec)
         for w in spec_warnings(spec.warnings, self.config):
             rospy.logwarn("rubass: %s", w.render(spec.sources))
-        with said_if_slow("rubass: setting up the actions waits for the master (a publisher or service registers "
-                          "with it): NO RULE IS ENFORCED until it answers"):
+        with said_if_slow("rubass: setting up the actions takes over a second (their publishers register with the "
+                          "master, which may not be answering; a serial port opens): NO RULE IS ENFORCED until it is "
+                          "done"):
             return spec, self._runners(spec, {})
 
     def _failed_text(self, exc: SpecError) -> str:

@@ -190,9 +190,9 @@ def test_a_master_lost_before_the_actions_are_set_up_is_said_and_enforcing_follo
     _wait_registered(ros, mon)
     time.sleep(0.3)  # the parameters are read (a few ms); the spec is being read (about a second)
     ros.master.stop()
-    rosharness.wait_log(mon, ros, "setting up the actions waits for the master", timeout=30)
+    rosharness.wait_log(mon, ros, "setting up the actions takes over a second", timeout=30)
     log = ros.log(mon)
-    assert "NO RULE IS ENFORCED until it answers" in log and "rubass: enforcing" not in log, log
+    assert "NO RULE IS ENFORCED until it is done" in log and "rubass: enforcing" not in log, log
     ros.master.restart()
     rosharness.wait_log(mon, ros, "rubass: enforcing", timeout=30)
     ros.wait_service("/rubass/reset", mon, timeout=20)
