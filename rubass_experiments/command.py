@@ -36,8 +36,8 @@ def run(args: argparse.Namespace) -> int:
     if args.reps < 1:
         print("rubass experiments: error: --reps must be at least 1", file=sys.stderr)
         return 2
-    try:
-        rows = [row(n) for n in args.only] if args.only else list(ROWS)
+    try:  # a row named twice runs once (twice, its second run replaced the first's folder and bag)
+        rows = list(dict.fromkeys(row(n) for n in args.only)) if args.only else list(ROWS)
     except KeyError as exc:
         print(f"rubass experiments: error: no row {exc}; rows: {', '.join(r.name for r in ROWS)}", file=sys.stderr)
         return 2
@@ -45,7 +45,17 @@ def run(args: argparse.Namespace) -> int:
         print("rubass experiments: error: ROS 1 is not installed (no rosmaster); run tools/demo.sh, which installs it",
               file=sys.stderr)
         return 1
+    from .runner import spec_problems
+
+    problems = spec_problems(rows)
+    if problems:
+        print("rubass experiments: error: " + "\nrubass experiments: error: ".join(problems), file=sys.stderr)
+        return 1
     out = os.path.abspath(args.out)
+    unwritable = _unwritable(out)
+    if unwritable:
+        print(f"rubass experiments: error: cannot write the results to {out} (--out): {unwritable}", file=sys.stderr)
+        return 1
     sup = Supervisor()
     try:
         with sup:
@@ -61,17 +71,20 @@ def _run(rows: List[Row], reps: int, out: str, sup: Supervisor) -> int:
 
     print(f"rubass experiments: {len(rows)} rows x {reps} runs; results in {out}", file=sys.stderr)
     outcome = main_loop(rows, reps, out, sup)
-    png = os.path.join(out, "table.png")
+    png, json_path = os.path.join(out, "table.png"), os.path.join(out, "table.json")
     with sup.deferred():  # the table is written whole; a signal meanwhile is raised after it
         data = results_json(rows, outcome.results)
         if outcome.signal is not None:
             data = _mark_interrupted(data, outcome, reps)
         table = io.StringIO()
         ok = print_table(data, table)
-        with open(os.path.join(out, "table.json"), "w") as fh:  # saved before anything is printed: a
-            json.dump(data, fh, indent=1)  # Ctrl-C on `demo.sh | tee` also ends tee, so printing can fail
+        # saved before anything is printed: a Ctrl-C on `demo.sh | tee` also ends tee, so printing can fail
+        saved = _save(json_path, data)
         _remove_plot(png)  # an earlier run's plot beside this table would disagree with it, if this one is not drawn
     _say(sys.stdout, table.getvalue())
+    if saved:  # the runs' figures are on the console above; the bags are under runs/
+        _say(sys.stderr, f"rubass experiments: error: cannot write {json_path}: {saved}\n")
+        json_path = "(not written)"
     if outcome.signal is None:
         try:
             plot(data, png)
@@ -79,10 +92,10 @@ def _run(rows: List[Row], reps: int, out: str, sup: Supervisor) -> int:
             with sup.deferred(raise_after=False):
                 _remove_plot(png)
                 _say(sys.stderr, f"rubass experiments: interrupted by {exc.name} after the runs: the plot was not "
-                                 f"drawn (table: {os.path.join(out, 'table.json')})\n")
+                                 f"drawn (table: {json_path})\n")
             return exc.exit_status
     bags = f"{os.path.join(out, 'runs')}/ROW/N/run.bag (rubass replay SPEC BAG)"
-    _say(sys.stdout, f"\ntable: {os.path.join(out, 'table.json')}\nplot:  "
+    _say(sys.stdout, f"\ntable: {json_path}\nplot:  "
                      f"{png if outcome.signal is None else '(not drawn: interrupted)'}\nbags:  {bags}\n")
     if outcome.signal is not None:
         exc = Interrupted(outcome.signal)
@@ -91,7 +104,30 @@ def _run(rows: List[Row], reps: int, out: str, sup: Supervisor) -> int:
         return exc.exit_status
     if not ok:
         _say(sys.stderr, "rubass experiments: some row did not stop every time or missed the (b) target\n")
-    return 0 if ok else 1
+    return 0 if ok and not saved else 1
+
+
+def _unwritable(out: str) -> str:
+    """Why the results cannot be written under `out` ("" when they can): found before any run."""
+    try:
+        os.makedirs(os.path.join(out, "runs"), exist_ok=True)
+        probe = os.path.join(out, f".rubass-write-test-{os.getpid()}")
+        with open(probe, "w"):
+            pass
+        os.remove(probe)
+    except OSError as exc:
+        return f"{exc.strerror or exc}" + (f" ({exc.filename})" if exc.filename and exc.filename != out else "")
+    return ""
+
+
+def _save(path: str, data: Dict[str, Any]) -> str:
+    """Write the table's JSON; why it could not be ("" when written)."""
+    try:
+        with open(path, "w") as fh:
+            json.dump(data, fh, indent=1)
+    except OSError as exc:
+        return exc.strerror or str(exc)
+    return ""
 
 
 def _remove_plot(png: str) -> None:

@@ -23,7 +23,7 @@ import time
 from dataclasses import asdict, dataclass, field
 from typing import Any, Dict, List, Optional, Tuple
 
-from rubass.lang import load_spec
+from rubass.lang import SpecError, load_spec
 from rubass.replay.run import replay
 from .rows import MONITOR_NICE, Row
 from rubass.ros.bag import BagError, open_bag, read
@@ -97,6 +97,26 @@ def _spec_for(row: Row, run_dir: str) -> str:
     with open(os.path.join(run_dir, "frobit_actions.yaml"), "w") as fh:
         fh.write(lib)
     return os.path.join(run_dir, row.spec)
+
+
+def spec_problems(rows: List[Row]) -> List[str]:
+    """Each row whose spec in config/ (or the Frobit's action library) is missing or does not check, with
+    the checker's errors: found before any run (a missing one broke the runs with a traceback, or read as a
+    missed stop)."""
+    problems: List[str] = []
+    checked: Dict[str, str] = {}
+    for r in rows:
+        if r.spec not in checked:
+            try:
+                load_spec(os.path.join(CONFIG, r.spec))
+                checked[r.spec] = ""
+            except SpecError as exc:
+                checked[r.spec] = exc.render()
+        if checked[r.spec]:
+            problems.append(f"row {r.name}: config/{r.spec} cannot be used:\n{checked[r.spec]}")
+        if r.robot == "frobit" and not os.path.isfile(os.path.join(CONFIG, "frobit_actions.yaml")):
+            problems.append(f"row {r.name}: config/frobit_actions.yaml is missing")
+    return problems
 
 
 def _bag_topics(row: Row) -> List[str]:
