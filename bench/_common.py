@@ -1,4 +1,5 @@
-"""Helpers shared by the benchmarks: the repository on sys.path, percentiles, machine facts."""
+"""Helpers shared by the benchmarks: the repository on sys.path, percentiles, machine facts, counts."""
+import argparse
 import math
 import os
 import platform
@@ -32,3 +33,19 @@ def machine():
         pass
     return {"python": platform.python_version(), "cpus": os.cpu_count(), "cpu": model,
             "loadavg_1min": round(os.getloadavg()[0], 2)}
+
+
+def above_zero(kind, zero_ok=False):
+    """An argparse type: a finite number of `kind` (int or float) above 0 (or 0 too), else a usage error
+    (a count of 0 gave a ZeroDivisionError, or NaN figures that are no JSON)."""
+    def parse(text):
+        try:
+            value = kind(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"invalid {kind.__name__} value: {text!r}") from None
+        if not math.isfinite(value) or value < 0 or (value == 0 and not zero_ok):
+            raise argparse.ArgumentTypeError(f"must be {'0 or more' if zero_ok else 'above 0'}, not {text}")
+        return value
+
+    parse.__name__ = kind.__name__
+    return parse

@@ -38,7 +38,11 @@ def start_monitor(master, tmp, spec, name="rubass", **params):
     args = [PY, os.path.join(_common.ROOT, "scripts", "monitor"), f"__name:={name}", f"_spec:={path}"]
     args += [f"_{k}:={v}" for k, v in params.items()]
     mon = master.spawn(args, log=os.path.join(tmp, "monitor.log"))
-    wait_for_service(f"/{name}/reset", mon, master.uri, 60)
+    try:
+        wait_for_service(f"/{name}/reset", mon, master.uri, 60)
+    except BaseException:  # a stop signal (Interrupted) or a monitor that did not start: the caller never has it
+        stop_processes([mon])
+        raise
     return mon, path
 
 

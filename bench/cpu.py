@@ -197,10 +197,13 @@ def base_rate(profile):
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--seconds", type=float, default=10.0, help="publishing window per run (default 10)")
+    ap.add_argument("--seconds", type=_common.above_zero(float), default=10.0,
+                    help="publishing window per run (default 10)")
     ap.add_argument("--cases", default="abc", help="which of a, b, c (default abc)")
     ap.add_argument("--smoke", action="store_true", help="tiny sizes, to check it works")
     args = ap.parse_args()
+    if not args.cases or set(args.cases) - set("abc"):
+        ap.error(f"argument --cases: letters of a, b and c (e.g. ab), not {args.cases!r}")
     seconds = 1.0 if args.smoke else args.seconds
     a_profile, a_spec = ("a2", spec_a(2, 6)) if args.smoke else ("a", spec_a())
     with tempfile.TemporaryDirectory() as tmp:

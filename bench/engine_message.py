@@ -67,7 +67,7 @@ def measure(n_rules, n_messages):
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--messages", type=int, default=50000, help="messages per case (default 50000)")
+    ap.add_argument("--messages", type=_common.above_zero(int), default=50000, help="messages per case (default 50000)")
     args = ap.parse_args()
     for n in (10, 100, 1000):
         print(json.dumps(measure(n, args.messages)), flush=True)

@@ -258,10 +258,10 @@ def parse_and_check(n_rules: int, repeat: int) -> dict:
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--messages", type=int, default=50000, help="messages per rule count in (a)")
-    ap.add_argument("--scans", type=int, default=5000, help="LaserScans in (b)")
-    ap.add_argument("--rules", type=int, default=1000, help="rules to parse and check in (c)")
-    ap.add_argument("--repeat", type=int, default=5, help="parse + check runs in (c)")
+    ap.add_argument("--messages", type=_common.above_zero(int), default=50000, help="messages per rule count in (a)")
+    ap.add_argument("--scans", type=_common.above_zero(int), default=5000, help="LaserScans in (b)")
+    ap.add_argument("--rules", type=_common.above_zero(int), default=1000, help="rules to parse and check in (c)")
+    ap.add_argument("--repeat", type=_common.above_zero(int), default=5, help="parse + check runs in (c)")
     args = ap.parse_args()
     for n in (10, 100, 1000):
         print(json.dumps(engine_per_message(n, args.messages)), flush=True)

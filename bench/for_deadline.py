@@ -73,7 +73,8 @@ def measure(durations, busy, default_slack=False):
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--firings", type=int, default=300, help="firings, each with a random T in [0, 0.1] s (default 300)")
+    ap.add_argument("--firings", type=_common.above_zero(int), default=300,
+                    help="firings, each with a random T in [0, 0.1] s (default 300)")
     ap.add_argument("--busy", action="store_true", help="a CPU-bound thread runs in the process")
     ap.add_argument("--default-slack", action="store_true",
                     help="leave the engine thread's timer slack at Linux's default (50 us), for comparison")

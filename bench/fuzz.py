@@ -22,7 +22,7 @@ from hypothesis import HealthCheck, given, seed, settings  # noqa: E402
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--cases", type=int, default=5000, help="hypothesis cases (default 5000)")
+    ap.add_argument("--cases", type=_common.above_zero(int), default=5000, help="hypothesis cases (default 5000)")
     ap.add_argument("--seed", type=int, default=int(time.time()), help="random seed (default: the time)")
     args = ap.parse_args()
     counts = {0: 0, 1: 0}

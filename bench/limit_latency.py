@@ -120,8 +120,9 @@ def summary(values):
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--samples", type=int, default=2000, help="commands per path")
-    ap.add_argument("--hz", type=float, default=150.0, help="commands per second, all paths together")
+    ap.add_argument("--samples", type=_common.above_zero(int), default=2000, help="commands per path")
+    ap.add_argument("--hz", type=_common.above_zero(float), default=150.0,
+                    help="commands per second, all paths together")
     ap.add_argument("--smoke", action="store_true", help="a short run (50 commands per path), to check it works")
     ap.add_argument("--role", choices=("relay", "receiver", "sender"), help=argparse.SUPPRESS)
     args = ap.parse_args()

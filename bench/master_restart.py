@@ -25,9 +25,9 @@ def known(master, topic, node="/rubass"):
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--restarts", type=int, default=10, help="master restarts (default 10)")
-    ap.add_argument("--down", type=float, default=1.0, help="seconds without a master each time")
-    ap.add_argument("--rate", type=float, default=4.0, help="the monitor's ~master_rate (Hz)")
+    ap.add_argument("--restarts", type=_common.above_zero(int), default=10, help="master restarts (default 10)")
+    ap.add_argument("--down", type=_common.above_zero(float), default=1.0, help="seconds without a master each time")
+    ap.add_argument("--rate", type=_common.above_zero(float), default=4.0, help="the monitor's ~master_rate (Hz)")
     ap.add_argument("--smoke", action="store_true", help="one restart, during the monitor's start-up")
     args = ap.parse_args()
     restarts = 1 if args.smoke else args.restarts

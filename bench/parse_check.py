@@ -53,8 +53,10 @@ def generate(n_rules: int, per_entity: int = 10) -> str:
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--rules", type=int, default=1000, help="rules in the generated spec (default 1000)")
-    ap.add_argument("--repeat", type=int, default=5, help="timed runs after one warm-up (default 5)")
+    ap.add_argument("--rules", type=_common.above_zero(int), default=1000,
+                    help="rules in the generated spec (default 1000)")
+    ap.add_argument("--repeat", type=_common.above_zero(int), default=5,
+                    help="timed runs after one warm-up (default 5)")
     args = ap.parse_args()
     with tempfile.TemporaryDirectory() as tmp:
         with open(os.path.join(tmp, "lib.yaml"), "w") as fh:

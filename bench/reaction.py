@@ -46,7 +46,7 @@ def summary(lat):
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--seconds", type=float, default=5.0, help="per case (default 5)")
+    ap.add_argument("--seconds", type=_common.above_zero(float), default=5.0, help="per case (default 5)")
     ap.add_argument("--smoke", action="store_true", help="one short case (100 Hz, 0.5 s), to check it works")
     args = ap.parse_args()
     cases = [(100, False)] if args.smoke else [(100, False), (1000, False), (100, True), (1000, True)]
@@ -61,6 +61,7 @@ def main():
                 ratio = b["p50_ms"] / (2 * a["p50_ms"]) if a["p50_ms"] else None
                 print(json.dumps({
                     "benchmark": "reaction", "rate_hz": hz, "background_load": loaded, "seconds": seconds,
+                    "smoke": args.smoke,  # `rubass report --bench` refuses a smoke run: it measures nothing
                     "raw_hop": a, "rubass": b, "rubass_unanswered": rb["unanswered"],
                     "rubass_extra_stops": rb.get("extra_stops", 0),
                     "ratio_p50_b_over_2a": None if ratio is None else round(ratio, 2),

@@ -22,7 +22,7 @@ from _rosbench import PrivateMaster, run_peer, spec_text, start_load, start_moni
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--reloads", type=int, default=10, help="SIGHUPs, 1.2 s apart (default 10)")
+    ap.add_argument("--reloads", type=_common.above_zero(int), default=10, help="SIGHUPs, 1.2 s apart (default 10)")
     ap.add_argument("--smoke", action="store_true", help="2 reloads of 101 rules, to check it works")
     args = ap.parse_args()
     reloads = 2 if args.smoke else args.reloads
@@ -30,6 +30,7 @@ def main():
     with tempfile.TemporaryDirectory() as tmp:
         master = PrivateMaster(os.path.join(tmp, "home"))
         load = start_load(master, 20, 100)
+        mon = None
         try:
             mon, path = start_monitor(master, tmp, spec_text(20, rules))
             seconds = reloads * 1.2 + 2.0
@@ -46,9 +47,8 @@ def main():
                 os.kill(mon.pid, signal.SIGHUP)
                 time.sleep(1.2)
             driver.join()
-            stop_processes([mon])
         finally:
-            stop_processes(load)
+            stop_processes(load + ([mon] if mon is not None else []))
             master.stop()
         log = open(os.path.join(tmp, "monitor.log")).read()
     times = [float(x) for x in re.findall(r"rubass: reloaded .* in (\d+) ms", log)]

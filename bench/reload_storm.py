@@ -24,10 +24,13 @@ from _rosbench import PrivateMaster, run_peer, spec_text, start_monitor, stop_pr
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--sighups", type=int, default=100, help="SIGHUPs sent (default 100)")
-    ap.add_argument("--seconds", type=float, default=10.0, help="over how many seconds (default 10)")
-    ap.add_argument("--hz", type=float, default=50.0, help="violation/clear alternations per second")
-    ap.add_argument("--rules", type=int, default=100, help="rules besides the measured one")
+    ap.add_argument("--sighups", type=_common.above_zero(int), default=100, help="SIGHUPs sent (default 100)")
+    ap.add_argument("--seconds", type=_common.above_zero(float), default=10.0,
+                    help="over how many seconds (default 10)")
+    ap.add_argument("--hz", type=_common.above_zero(float), default=50.0,
+                    help="violation/clear alternations per second")
+    ap.add_argument("--rules", type=_common.above_zero(int, zero_ok=True), default=100,
+                    help="rules besides the measured one")
     ap.add_argument("--smoke", action="store_true", help="10 SIGHUPs in 2 s over 20 rules, to check it works")
     args = ap.parse_args()
     if args.smoke:
@@ -58,7 +61,9 @@ def main():
                 os.kill(mon.pid, signal.SIGHUP)
                 if i == args.sighups // 10:
                     warm = [proc.memory_info().rss, proc.num_threads()]
-                time.sleep(gap if i != broken_at else max(gap, 0.5))  # long enough to be read, not coalesced
+                # around the broken rewrite, long enough for each reload to be read on its own: the reload
+                # before it must not read the broken file too (one broken spec counted as two rejections)
+                time.sleep(gap if i not in (broken_at - 1, broken_at) else max(gap, 0.5))
             driver.join()
             time.sleep(1.0)  # the last reloads settle
             after = [proc.memory_info().rss, proc.num_threads()]

@@ -53,7 +53,8 @@ def make_bag(path, n):
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--messages", type=int, default=1000000, help="messages in the generated bag (default 1000000)")
+    ap.add_argument("--messages", type=_common.above_zero(int), default=1000000,
+                    help="messages in the generated bag (default 1000000)")
     ap.add_argument("--dir", default=os.path.join(tempfile.gettempdir(), "rubass-bench"),
                     help="where the bag is generated (and kept for the next run)")
     args = ap.parse_args()

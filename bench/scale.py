@@ -65,7 +65,8 @@ def case(master, tmp, topics, rules, seconds):
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--seconds", type=float, default=5.0, help="measured seconds per case (default 5)")
+    ap.add_argument("--seconds", type=_common.above_zero(float), default=5.0,
+                    help="measured seconds per case (default 5)")
     ap.add_argument("--smoke", action="store_true", help="one short case (10 topics, 10 rules), to check it works")
     args = ap.parse_args()
     grid = [(10, 10)] if args.smoke else \

@@ -38,9 +38,9 @@ def soak_spec(topics):
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--seconds", type=float, default=600.0, help="how long (default 600)")
-    ap.add_argument("--topics", type=int, default=10, help="load topics (default 10)")
-    ap.add_argument("--hz", type=float, default=100.0, help="messages per second on each topic")
+    ap.add_argument("--seconds", type=_common.above_zero(float), default=600.0, help="how long (default 600)")
+    ap.add_argument("--topics", type=_common.above_zero(int), default=10, help="load topics (default 10)")
+    ap.add_argument("--hz", type=_common.above_zero(float), default=100.0, help="messages per second on each topic")
     ap.add_argument("--smoke", action="store_true", help="5 s over 2 topics, to check it works")
     args = ap.parse_args()
     if args.smoke:

@@ -45,7 +45,8 @@ def per_message(n, stub):
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--messages", type=int, default=100_000, help="messages per round (default 100000)")
+    ap.add_argument("--messages", type=_common.above_zero(int), default=100_000,
+                    help="messages per round (default 100000)")
     args = ap.parse_args()
     with_us, without_us, calls = float("inf"), float("inf"), 0
     for _ in range(3):  # alternate and keep the best of each: the machine is shared

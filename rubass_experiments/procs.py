@@ -113,6 +113,9 @@ class Supervisor:
         try:
             self.stop_all()
             self._close_reaper()
+            # and what was started without spawn (with the marker, from os.environ) or whose Popen a signal
+            # kept from its caller: a monitor still starting, a peer a thread ran (benchmarks left them running)
+            sweep(self.marker, self._stop_sig)
         finally:
             for sig, old in self._old.items():
                 signal.signal(sig, old if old is not None else signal.SIG_DFL)
@@ -292,9 +295,18 @@ def reap(marker: str) -> None:
             groups[int(word[1])] = int(word[2])
         elif word[:1] == ["del"] and len(word) == 2:
             groups.pop(int(word[1]), None)
-    for pid, pgid in _ours(marker).items():
+    sweep(marker, groups)
+
+
+def sweep(marker: str, stop_signals: Optional[Dict[int, int]] = None) -> None:
+    """Stop every process (but this one) that carries the marker: its group's stop signal from
+    `stop_signals` (by group leader's pid; SIGTERM when not there), then SIGKILL after GRACE seconds."""
+    found = _ours(marker)
+    if not found:
+        return
+    for pid, pgid in found.items():
         with contextlib.suppress(OSError):
-            os.kill(pid, groups.get(pgid, signal.SIGTERM))
+            os.kill(pid, (stop_signals or {}).get(pgid, signal.SIGTERM))
     end = time.monotonic() + GRACE
     while time.monotonic() < end and _ours(marker):
         time.sleep(0.1)

@@ -27,14 +27,16 @@ class Reaction:
     cases: int
     developers: bool = False  # the figures of bench/README.md: the developers' machine, not this one
     date: str = ""  # the date of the developers' figures, when the README gives one
+    extent: str = ""  # what was measured: rates, load, violations, seconds (a file given with --bench)
 
     def figures(self) -> str:
         """The figures as what they are: one case's, or the largest of each over several cases (the p50
-        shown is then no median of anything: the slowest case's)."""
+        shown is then no median of anything: the slowest case's), and what was measured."""
+        extent = f" ({self.extent})" if self.extent else ""
         if self.cases == 1:
-            return f"p50 {up(self.p50_ms)} ms, p99 {up(self.p99_ms)} ms, worst {up(self.worst_ms)} ms"
+            return f"p50 {up(self.p50_ms)} ms, p99 {up(self.p99_ms)} ms, worst {up(self.worst_ms)} ms{extent}"
         return (f"largest p50 {up(self.p50_ms)} ms, largest p99 {up(self.p99_ms)} ms and worst {up(self.worst_ms)} ms "
-                f"over {self.cases} cases")
+                f"over {self.cases} cases{extent}")
 
     def p99_label(self) -> str:
         return "p99" if self.cases == 1 else f"largest p99 of {self.cases} cases"
@@ -63,6 +65,8 @@ def from_json_lines(path: str) -> Reaction:
     """The output of `bench/reaction.py` (JSON lines). Raises BenchError when the file cannot be read or
     holds no reaction figure (lines that are no JSON are skipped while some line holds figures)."""
     worst, p99, p50, n = 0.0, 0.0, 0.0, 0
+    rates: List[str] = []
+    loaded, violations, seconds = 0, 0, 0.0
     first_bad = ""
     try:
         with open(path, encoding="utf-8") as fh:
@@ -82,6 +86,10 @@ def from_json_lines(path: str) -> Reaction:
         if not (isinstance(obj, dict) and obj.get("benchmark") == "reaction"):
             first_bad = first_bad or f"line {number} holds no reaction figures"
             continue
+        if obj.get("smoke") is True:
+            raise BenchError(f"{path}:{number}: a --smoke run of bench/reaction.py (one short case, to check that "
+                             f"the script works) is no measurement of the monitor's reaction; run it without "
+                             f"--smoke")
         rb = obj.get("rubass")
         if not isinstance(rb, dict):  # a reaction case without figures bounds nothing: not skipped
             raise BenchError(f"{path}:{number}: a reaction case without its figures (\"rubass\" is "
@@ -105,9 +113,27 @@ def from_json_lines(path: str) -> Reaction:
                              f"bound; measure again")
         worst, p99, p50 = max(worst, figures[0]), max(p99, figures[1]), max(p50, figures[2])
         n += 1
+        rate = f"{obj.get('rate_hz')} Hz" if isinstance(obj.get("rate_hz"), (int, float)) else ""
+        if rate and rate not in rates:
+            rates.append(rate)
+        loaded += obj.get("background_load") is True
+        violations += rb.get("n") if isinstance(rb.get("n"), int) else 0
+        seconds += obj.get("seconds") if isinstance(obj.get("seconds"), (int, float)) else 0.0
     if not n:
         raise BenchError(f"{path}: no reaction figures ({first_bad or 'the file is empty'}); {_EXPECTED}")
-    return Reaction(worst, p99, p50, f"{path} (bench/reaction.py)", n)
+    return Reaction(worst, p99, p50, f"{path} (bench/reaction.py)", n, extent=_extent(rates, loaded, n, violations,
+                                                                                      seconds))
+
+
+def _extent(rates: List[str], loaded: int, cases: int, violations: int, seconds: float) -> str:
+    """What a benchmark file measured, for the page: "at 100 and 1000 Hz, 2 of 4 cases under background
+    load, 3,000 violations in 20 s" (a short or unloaded measurement shows as one)."""
+    parts = [f"at {' and '.join(rates)}"] if rates else []
+    parts.append("no case under background load" if not loaded else
+                 "under background load" if loaded == cases == 1 else f"{loaded} of {cases} cases under background load")
+    if violations:
+        parts.append(f"{violations:,} violations" + (f" in {seconds:g} s" if seconds else ""))
+    return ", ".join(parts)
 
 
 def from_readme(path: str = README) -> Optional[Reaction]:

@@ -104,7 +104,8 @@ def _reaction_card(ev: Evidence) -> str:
     if r is None:
         return "<b>n/a</b>no benchmark figures"
     where = (f"the developers' figures{f' of {_e(r.date)}' if r.date else ''} (bench/README.md), "
-             f"<span class='fail'>not measured on this machine</span>" if r.developers else f"measured: {_e(r.source)}")
+             f"<span class='fail'>not measured on this machine</span>" if r.developers else
+             f"measured: {_e(r.source)}{f': {_e(r.extent)}' if r.extent else ''}")
     return f"<b>≤ {up(r.worst_ms)} ms</b>monitor's worst case ({_e(r.p99_label())} {up(r.p99_ms)} ms); {where}"
 
 

@@ -61,3 +61,22 @@ def test_every_benchmark_help_starts_with_a_complete_sentence(script):
     doc = ast.get_docstring(ast.parse(open(os.path.join(ROOT, "bench", script), encoding="utf-8").read()))
     first = doc.splitlines()[0]
     assert first.rstrip().endswith((".", ")")), f"{script}: --help's description stops mid-sentence: {first!r}"
+
+
+def test_a_count_or_duration_of_0_is_a_usage_error_not_a_traceback():
+    """A benchmark sweep: `--repeat 0`, `--messages 0`, `--seconds 0` … gave ZeroDivisionError, an empty
+    max(), or NaN figures that are no JSON; `--cases xyz` measured nothing and said nothing."""
+    import argparse
+
+    count, seconds = _common.above_zero(int), _common.above_zero(float)
+    assert count("3") == 3 and seconds("0.5") == 0.5 and _common.above_zero(int, zero_ok=True)("0") == 0
+    for parse, text in ((count, "0"), (count, "-5"), (seconds, "0"), (seconds, "nan"), (seconds, "inf"),
+                        (count, "x")):
+        with pytest.raises(argparse.ArgumentTypeError):
+            parse(text)
+    import subprocess
+    for script, args in (("parse_check.py", ["--repeat", "0"]), ("reaction.py", ["--seconds", "0"]),
+                         ("cpu.py", ["--cases", "xyz"]), ("replay_throughput.py", ["--messages", "-5"])):
+        out = subprocess.run(["/usr/bin/python3", os.path.join(ROOT, "bench", script)] + args,
+                             capture_output=True, text=True, timeout=60)
+        assert out.returncode == 2 and "error: argument" in out.stderr and "Traceback" not in out.stderr, out.stderr

@@ -147,3 +147,44 @@ def test_an_adopted_process_outside_any_group_of_its_own_is_stopped_too():
         t0 = time.monotonic()
         sup.stop([p])
         assert p.returncode == -signal.SIGTERM and time.monotonic() - t0 < 4.0
+
+
+def test_leaving_stops_the_processes_started_without_spawn_too(mark):
+    """A benchmark sweep: a peer run from a thread (subprocess.run), and one that ignores SIGTERM, were
+    left running after the command ended: they carry the marker, and leaving stops them (SIGKILL after
+    the grace for the one that ignores SIGTERM)."""
+    child = _run_child("""
+        a = subprocess.Popen(["sleep", "60"], start_new_session=True)
+        b = subprocess.Popen(["sh", "-c", "trap '' TERM; sleep 60 & wait; sleep 60"], start_new_session=True)
+        print(a.pid, b.pid, flush=True)
+        time.sleep(0.3)  # the shell's trap is set
+    """, mark)
+    pids = [int(p) for p in child.stdout.readline().split()]
+    assert len(pids) == 2 and all(_alive(p) for p in pids)
+    assert child.wait(15) == 0
+    assert _wait_dead(pids, 2.0) == []
+
+
+def test_a_script_stopped_while_it_waits_on_a_process_it_just_started_stops_that_process(mark):
+    """A benchmark sweep: SIGTERM while `start_monitor` waited for the monitor's service (its Popen never
+    reached the caller's `finally`) left the monitor running, orphaned; likewise for a Ctrl-C."""
+    code = textwrap.dedent(f"""
+        import subprocess, sys, time
+        sys.path.insert(0, {ROOT!r})
+        from rubass_experiments.procs import supervise_script
+        supervise_script("bench")
+        def start():
+            p = subprocess.Popen(["sleep", "60"], start_new_session=True, stdout=subprocess.DEVNULL,
+                                 stderr=subprocess.DEVNULL)
+            print(p.pid, flush=True)
+            time.sleep(60)  # waiting for its service
+            return p
+        start()
+    """)
+    child = subprocess.Popen([sys.executable, "-c", code], env=dict(os.environ, **{MARK: mark}),
+                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, start_new_session=True)
+    pid = int(child.stdout.readline())
+    os.kill(child.pid, signal.SIGTERM)
+    assert child.wait(15) == 143
+    assert "bench: interrupted by SIGTERM" in child.stderr.read()
+    assert _wait_dead([pid], 2.0) == []

@@ -118,3 +118,35 @@ def test_a_test_file_that_cannot_run_is_named_on_the_last_line(write, tmp_path, 
     code = main(["report", path, "--tests", broken, "-o", str(tmp_path / "r.html")])
     out = capsys.readouterr().out
     assert code == 1 and out.rstrip().splitlines()[-1].endswith(f"; not run: {broken}"), out
+
+
+SMOKE = ('{"benchmark": "reaction", "rate_hz": 100, "background_load": false, "seconds": 0.5, "smoke": true, '
+         '"rubass": {"n": 25, "p50_ms": 0.667, "p99_ms": 6.336, "max_ms": 6.336}, "rubass_unanswered": 0, '
+         '"rubass_extra_stops": 0}\n')
+
+
+def test_a_smoke_run_is_no_measurement(write):
+    """A benchmark sweep: a 0.5 s, one-case --smoke run was stated as "the monitor's worst case"."""
+    with pytest.raises(BenchError) as err:
+        from_json_lines(write("reaction.jsonl", SMOKE))
+    assert "reaction.jsonl:1: a --smoke run of bench/reaction.py" in str(err.value)
+    assert "run it without --smoke" in str(err.value)
+
+
+def test_the_page_says_what_the_benchmark_measured(write, tmp_path, capsys):
+    """Rates, load, violations and seconds beside the figures: a short or unloaded measurement shows as one,
+    and the command says when no case was under load."""
+    lines = [SMOKE.replace('"smoke": true', '"smoke": false').replace('"background_load": false', f'"background_load": {b}')
+             .replace('"rate_hz": 100', f'"rate_hz": {hz}').replace('"seconds": 0.5', '"seconds": 5')
+             .replace('"n": 25', f'"n": {n}') for hz, b, n in ((100, "false", 500), (1000, "false", 2500),
+                                                                  (100, "true", 500), (1000, "true", 2500))]
+    r = from_json_lines(write("full.jsonl", "".join(lines)))
+    assert r.extent == "at 100 Hz and 1000 Hz, 2 of 4 cases under background load, 6,000 violations in 20 s"
+    write("lib.yaml", LIB)
+    path = write("s.rbs", SPEC)
+    out = str(tmp_path / "r.html")
+    main(["report", path, "--bench", write("one.jsonl", lines[0]), "-o", out])
+    err = capsys.readouterr().err
+    assert "has no case under background load" in err, err
+    html = open(out, encoding="utf-8").read()
+    assert "at 100 Hz, no case under background load, 500 violations in 5 s" in html
