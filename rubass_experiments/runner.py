@@ -100,7 +100,7 @@ def _spec_for(row: Row, run_dir: str) -> str:
 
 
 def spec_problems(rows: List[Row]) -> List[str]:
-    """Each row whose spec in config/ (or the Frobit's action library) is missing or does not check, with
+    """Each row whose spec in config/ (or an action library it imports) is missing or does not check, with
     the checker's errors: found before any run (a missing one broke the runs with a traceback, or read as a
     missed stop)."""
     problems: List[str] = []
@@ -112,10 +112,8 @@ def spec_problems(rows: List[Row]) -> List[str]:
                 checked[r.spec] = ""
             except SpecError as exc:
                 checked[r.spec] = exc.render()
-        if checked[r.spec]:
+        if checked[r.spec]:  # its action library too: the spec imports it
             problems.append(f"row {r.name}: config/{r.spec} cannot be used:\n{checked[r.spec]}")
-        if r.robot == "frobit" and not os.path.isfile(os.path.join(CONFIG, "frobit_actions.yaml")):
-            problems.append(f"row {r.name}: config/frobit_actions.yaml is missing")
     return problems
 
 
