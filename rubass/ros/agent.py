@@ -279,8 +279,12 @@ def main(argv: Optional[List[str]] = None) -> int:
     stop = threading.Event()
     # our own SIGINT/SIGTERM: rospy's runs its shutdown on the main thread, which then waits for
     # good to unregister from a master that does not answer (a cut link), and never leaves the loop
+    def on_stop_signal(signum: int, frame: object) -> None:
+        stop.set()  # and should the agent never get to stop (a master that hangs while it reads its
+        exit_within(EXIT_GRACE + 1.0, 0, AGENT_DONE, "the agent did not stop")  # parameters): cut
+
     for sig in (signal.SIGINT, signal.SIGTERM):
-        signal.signal(sig, lambda signum, frame: stop.set())
+        signal.signal(sig, on_stop_signal)
     if stop_asked():  # one came between init_node and the lines above
         stop.set()
     keep_rosout_flag()  # no log call asks the master anything (one would block while its host is cut off)

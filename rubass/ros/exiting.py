@@ -10,14 +10,15 @@ import time
 EXIT_GRACE = 5.0  # s: rospy's own shutdown, after the monitor's, before the process exits anyway
 
 
-def exit_within(seconds: float, code: int = 0, done: str = "the monitor had already stopped") -> None:
+def exit_within(seconds: float, code: int = 0, done: str = "the monitor had already stopped",
+                what: str = "rospy did not shut down") -> None:
     """Exit with `code` after `seconds` whatever is still running: rospy's shutdown waits for a subscription
     that retries a master which is down (its topic manager's lock), and so did the process, for good.
-    `done`: what had been done before, for the line that says so."""
+    `done`: what had been done before, and `what` did not happen in time, for the line that says so."""
     def cut() -> None:
         time.sleep(seconds)
-        sys.stderr.write(f"[rubass] rospy did not shut down within {seconds:g} s (a registration waits for the "
-                         f"master): exiting; {done}\n")
+        sys.stderr.write(f"[rubass] {what} within {seconds:g} s (a registration waits for the master): "
+                         f"exiting; {done}\n")
         sys.stderr.flush()
         sys.stdout.flush()
         os._exit(code)

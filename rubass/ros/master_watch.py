@@ -118,22 +118,25 @@ class MasterWatch:
             except Exception as exc:  # never let the watch die: log and poll again
                 self.log("error", f"master watch: {exc.__class__.__name__}: {exc}")
 
+    def _unreachable(self, exc: BaseException) -> str:
+        first = self.down_since is None
+        if first:
+            self.down_since = time.monotonic()
+        # the state first: with the master's host cut off, rospy's log call itself can block
+        # (its /rosout goes there) until the link is back, and /diagnostics must say it meanwhile
+        self.state = f"unreachable for {time.monotonic() - self.down_since:.1f} s"
+        if first:
+            means = self.unreachable() if callable(self.unreachable) else self.unreachable
+            self.log("warn", f"the master at {self.master_uri} cannot be reached ({exc}): {means}")
+        return "unreachable"
+
     def check(self) -> str:
         """One poll: 'ok', 'unreachable', 'foreign' (another node holds our name) or 're-registered'."""
         try:
             code, msg, uri = self._caller.call("lookupNode", self.caller_id, self.caller_id)
             pid = self._caller.call("getPid", self.caller_id)[2]
         except (OSError, socket.error, xmlrpc.client.Error) as exc:
-            first = self.down_since is None
-            if first:
-                self.down_since = time.monotonic()
-            # the state first: with the master's host cut off, rospy's log call itself can block
-            # (its /rosout goes there) until the link is back, and /diagnostics must say it meanwhile
-            self.state = f"unreachable for {time.monotonic() - self.down_since:.1f} s"
-            if first:
-                means = self.unreachable() if callable(self.unreachable) else self.unreachable
-                self.log("warn", f"the master at {self.master_uri} cannot be reached ({exc}): {means}")
-            return "unreachable"
+            return self._unreachable(exc)
         was_down, self.down_since = self.down_since, None
         was_pid, self.master_pid = self.master_pid, pid
         if code == 1 and uri != self.node_uri:  # rospy shuts a node down when another takes its name: no fight
@@ -148,10 +151,12 @@ class MasterWatch:
                f"answers from another process (pid {was_pid}, now {pid}: it restarted)")
         try:
             reg = register_all(rpc.proxy(self.master_uri, self.timeout), self.caller_id, self.node_uri)
-        except Exception:
+        except Exception as exc:
             self.master_pid = was_pid  # not done: the next poll tries again
             if was_down is not None:
                 self.down_since = was_down
+            if isinstance(exc, (ConnectionError, socket.timeout)):  # it went away meanwhile: said as such
+                return self._unreachable(exc)
             raise
         self.state = "connected"
         if not why:

@@ -110,6 +110,7 @@ class Monitor(Reloading):
         self.retired_failures = 0  # failed attempts of runners a reload replaced: `failed action attempts` is since start
         self.loop: Optional[EngineLoop] = None
         self.load_error = ""  # why the monitor is not enforcing, while it is not
+        self.enforcing = False  # the engine's thread runs (ticks, deadlines): set once, at the end of _enforce
         self.withheld: List[Latch] = []  # latches on actions the spec does not declare: no ~heartbeat meanwhile
 
     # -- start-up ------------------------------------------------------------------------
@@ -211,8 +212,12 @@ class Monitor(Reloading):
             self.request_reload(f"{asked}, asked while the monitor started")
 
     def request_stop(self, signum: int = 0, frame: object = None) -> None:
-        """Stop the monitor (SIGINT, SIGTERM): actions released on the main thread, which run() ends."""
+        """Stop the monitor (SIGINT, SIGTERM): actions released on the main thread, which run() ends.
+        Before it enforces, the start stops at its next step; one that waits for a master that does not
+        answer (an action's publisher registering) is cut after EXIT_GRACE seconds."""
         self._exit.set()
+        if not self.enforcing and not self._stopping:
+            exit_within(EXIT_GRACE, 0, "nothing was enforced", "the monitor's start did not stop")
 
     def _not_enforcing(self, error: str) -> None:
         self.load_error = error
@@ -315,6 +320,7 @@ class Monitor(Reloading):
             counted(n, noun) for n, noun in ((len(spec.rules), "rule"), (len(spec.behaviours), "behaviour"),
                                              (len(self.watcher.topics), "topic"), (len(spec.nodes), "node"))))
         threading.Thread(target=self._engine_thread, name="rubass-engine", daemon=True).start()
+        self.enforcing = True
 
     def _install_control(self) -> None:
         """Services and the master watch: up whether or not the spec can be enforced. The services
@@ -339,7 +345,7 @@ class Monitor(Reloading):
 
     def _unreachable_means(self) -> str:
         """What a master that stops answering means for the robot, as the monitor stands."""
-        if self.loop is not None:
+        if self.enforcing:  # not `loop`: it is set a second before, while the topics are subscribed
             return MONITOR_UNREACHABLE
         if self.load_error:
             return ("NO RULE IS ENFORCED (the spec cannot be used, see above); nodes started now cannot connect to the "

@@ -7,7 +7,7 @@ import sys
 import time
 from typing import Any, Callable, List, Optional
 
-from .exiting import exit_within
+from .exiting import EXIT_GRACE, exit_within
 
 
 class _Stopped(BaseException):
@@ -107,9 +107,10 @@ def init_node(name: str, argv: Optional[List[str]], say: Callable[[str], None]) 
         pass
     except OSError as exc:  # the master went away between our wait and rospy's calls
         failed = f"the ROS master at {uri} stopped answering during the start ({exc.strerror or exc})"
-    except rospy.exceptions.ROSInitException as exc:
+    except rospy.exceptions.ROSInitException as exc:  # rospy's words for a master that went away: ours
         if not (stopped or rospy.is_shutdown()):
-            failed = f"cannot start: {exc}"
+            failed = (f"cannot start: {exc}" if master_answers(uri) else
+                      f"the ROS master at {uri} stopped answering during the start ({exc})")
     except TypeError as exc:  # rospy stores each _NAME:= on the master; XML-RPC has no null
         nulls = null_params(sys.argv if argv is None else argv)
         failed = (f"cannot start: {', '.join('~' + n for n in nulls)}: null is no parameter value (the master "
@@ -149,7 +150,10 @@ _ASKED: List[int] = []  # SIGINT/SIGTERM after the node is up, before it install
 
 
 def _ask_stop(signum: int, _frame: object) -> None:
+    """Noted for the node's own handlers; should it never get there (a master that hangs while the
+    parameters are read: rospy's calls have no timeout), the process exits after EXIT_GRACE seconds."""
     _ASKED.append(signum)
+    exit_within(EXIT_GRACE, 0, "nothing had been started", "the node did not reach its own stop")
 
 
 def stop_asked() -> bool:

@@ -127,6 +127,48 @@ def test_a_signal_during_rospys_own_start_does_not_say_the_master_never_answered
     assert "before the ROS master" not in out.stderr
 
 
+def test_a_master_lost_inside_rospys_start_is_named_not_rospys_failed_to_initialize_time():
+    """A re-sweep: rospy wraps the socket error of a master that went away during its start as "Failed to
+    initialize time. Please check logs", which was all the monitor and the agent said."""
+    out = _started_with("answers = iter([True])\nstartup.master_answers = lambda uri: next(answers, False)\n"
+                        "def init_node(*a, **k):\n"
+                        "    raise rospy.exceptions.ROSInitException('Failed to initialize time. Please check logs')\n"
+                        "rospy.init_node = init_node\n"
+                        "sys.exit(startup.init_node('probe', ['probe'], lambda t: sys.stderr.write(t + '\\n')))\n")
+    assert out.returncode == 1, out.stderr
+    assert "the ROS master at http://127.0.0.1:1 stopped answering during the start (Failed to initialize time" \
+        in out.stderr, out.stderr
+
+
+def test_a_stop_asked_while_a_hung_master_holds_the_parameters_ends_the_process():
+    """A re-sweep: a master that hangs (SIGSTOP) after init_node held rospy's parameter calls, which have no
+    timeout, and the SIGTERM noted for the node's own handlers never got there: only SIGKILL ended it."""
+    t0 = time.monotonic()
+    out = _started_with("rospy.init_node = lambda *a, **k: None\n"
+                        "assert startup.init_node('probe', ['probe'], print) is None\n"
+                        "os.kill(os.getpid(), signal.SIGTERM)\ntime.sleep(25)  # rospy.get_param on a hung master\n")
+    assert out.returncode == 0 and time.monotonic() - t0 < 15, out.stderr
+    assert "[rubass] the node did not reach its own stop within 5 s" in out.stderr, out.stderr
+
+
+def test_a_sigterm_while_the_start_waits_for_the_master_ends_the_monitor(ros, tmp_path):
+    """A re-sweep: a SIGTERM while the actions' publishers waited for a master that was down was kept
+    until the master came back (27 s and more; for good if it never did)."""
+    (tmp_path / "lib.yaml").write_text(rosharness.LIB)
+    spec = tmp_path / "s.rbs"
+    _big_spec(spec, 1)
+    mon = ros.monitor(str(spec), wait=False)
+    _wait_registered(ros, mon)
+    time.sleep(0.3)
+    ros.master.stop()
+    rosharness.wait_log(mon, ros, "setting up the actions takes over a second", timeout=30)
+    t0 = time.monotonic()
+    mon.send_signal(signal.SIGTERM)
+    assert mon.wait(15) == 0, ros.log(mon)
+    assert time.monotonic() - t0 < 10
+    assert "the monitor's start did not stop within 5 s" in ros.log(mon) and "nothing was enforced" in ros.log(mon)
+
+
 @pytest.mark.parametrize("reload_first", [False, True], ids=["", "after-a-reload"])
 def test_sigint_while_waiting_for_the_first_clock_says_no_clock_came(ros, tmp_path, reload_first):
     import rosgraph

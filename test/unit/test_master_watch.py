@@ -101,3 +101,40 @@ def test_the_state_says_unreachable_before_the_log_line_is_written():
     watch._caller = ScriptedMaster([OSError("timed out")])
     assert watch.check() == "unreachable"
     assert len(states) == 1 and states[0].startswith("unreachable for"), states
+
+
+def test_a_master_lost_during_the_registration_is_unreachable_not_an_error(monkeypatch):
+    """A re-sweep: the master died while the first poll registered everything: `master watch:
+    ConnectionRefusedError` was logged as an ERROR, and nothing said the master was down."""
+    lines = []
+    watch = MasterWatch("/rubass", ME, "http://master:11311", 0.25, lambda level, text: lines.append((level, text)),
+                        unreachable=lambda: "STARTING")
+    watch._caller = ScriptedMaster([(ME, 7), (ME, 7)])
+    calls = []
+
+    def register_all(master, caller_id, node_uri):
+        calls.append(1)
+        if len(calls) == 1:
+            raise ConnectionRefusedError(111, "Connection refused")
+        return Registered(1, 1, 1, 1.0)
+
+    monkeypatch.setattr(master_watch, "register_all", register_all)
+    assert watch.check() == "unreachable" and watch.state.startswith("unreachable for")
+    assert lines == [("warn", "the master at http://master:11311 cannot be reached ([Errno 111] Connection refused): "
+                              "STARTING")]
+    assert watch.check() == "re-registered" and watch.state == "connected"  # it is back: all of it again
+
+
+def test_the_monitor_says_it_enforces_nothing_until_its_engine_runs():
+    """A re-sweep: the warning said "the rules keep being enforced" for the second between the engine's
+    creation and its thread's start (while the topics were subscribed, with the master down)."""
+    from types import SimpleNamespace
+
+    from rubass.ros.monitor import Monitor
+
+    means = Monitor._unreachable_means
+    assert means(SimpleNamespace(enforcing=False, loop=object(), load_error="")) == \
+        master_watch.MONITOR_STARTING_UNREACHABLE
+    assert means(SimpleNamespace(enforcing=False, loop=None, load_error="s.rbs:1:1: error")).startswith(
+        "NO RULE IS ENFORCED (the spec cannot be used")
+    assert means(SimpleNamespace(enforcing=True, loop=object(), load_error="")) == master_watch.MONITOR_UNREACHABLE
