@@ -28,6 +28,7 @@ class Reaction:
     developers: bool = False  # the figures of bench/README.md: the developers' machine, not this one
     date: str = ""  # the date of the developers' figures, when the README gives one
     extent: str = ""  # what was measured: rates, load, violations, seconds (a file given with --bench)
+    loaded_cases: Optional[int] = None  # how many of its cases ran under background load (a file given with --bench)
 
     def figures(self) -> str:
         """The figures as what they are: one case's, or the largest of each over several cases (the p50
@@ -121,8 +122,8 @@ def from_json_lines(path: str) -> Reaction:
         seconds += obj.get("seconds") if isinstance(obj.get("seconds"), (int, float)) else 0.0
     if not n:
         raise BenchError(f"{path}: no reaction figures ({first_bad or 'the file is empty'}); {_EXPECTED}")
-    return Reaction(worst, p99, p50, f"{path} (bench/reaction.py)", n, extent=_extent(rates, loaded, n, violations,
-                                                                                      seconds))
+    return Reaction(worst, p99, p50, f"{path} (bench/reaction.py)", n,
+                    extent=_extent(rates, loaded, n, violations, seconds), loaded_cases=loaded)
 
 
 def _extent(rates: List[str], loaded: int, cases: int, violations: int, seconds: float) -> str:

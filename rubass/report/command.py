@@ -116,7 +116,7 @@ def run(args: argparse.Namespace) -> int:
              else "")
           + (f"; not run: {', '.join(r.path for r in results if r.error)}" if any(r.error for r in results) else "")
           + (f"; not replayed: {', '.join(b.path for b in bags if b.error)}" if any(b.error for b in bags) else ""))
-    if reaction is not None and not reaction.developers and "no case under background load" in reaction.extent:
+    if reaction is not None and reaction.loaded_cases == 0:
         print(f"note: {args.bench} has no case under background load (bench/reaction.py without --smoke runs two): "
               f"the worst case on the page may understate the reaction on a busy computer", file=sys.stderr)
     if reaction is not None and reaction.developers:
