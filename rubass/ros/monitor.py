@@ -43,7 +43,7 @@ import queue
 import signal
 import threading
 import time
-from typing import Any, Dict, List, Optional, Tuple
+from typing import Any, Callable, Dict, List, Optional, Tuple
 
 import rosgraph
 import rospy
@@ -88,6 +88,18 @@ def _log(level: str, text: str) -> None:
 
 def _ros_now() -> float:
     return ros_now()
+
+
+def _register_aside(what: str, register: Callable[[], Any]) -> None:
+    """Register a service or subscription on a thread of its own: rospy retries it on the calling thread,
+    holding its lock, until the master answers, and the start must go on (enforcing) meanwhile."""
+    def run() -> None:
+        try:
+            register()
+        except Exception as exc:  # noqa: BLE001 - the rules are enforced either way; the log says what is missing
+            _log("error", f"rubass: cannot {what}: {exc.__class__.__name__}: {exc}")
+
+    threading.Thread(target=run, name="rubass-register", daemon=True).start()
 
 
 class Monitor(Reloading):
@@ -311,9 +323,9 @@ class Monitor(Reloading):
         self.watcher.sync(spec)
         self.livecheck = LiveTypeCheck(_log)  # the spec against the types its topics turn out to carry
         self.agents = AgentBook()  # cpu and memory of nodes on other hosts, from their agents
-        # rospy waits for the master to register a subscription or a service (holding its lock): not here,
-        # where a master that went down while the spec was read would hold every rule unenforced
-        threading.Thread(target=self._subscribe_agents, name="rubass-agents", daemon=True).start()
+        # the nodes of other hosts read unknown, and say why, until it is registered
+        _register_aside(f"subscribe to {AGENT_TOPIC}", lambda: rospy.Subscriber(
+            AGENT_TOPIC, String, self._on_agent, queue_size=100, tcp_nodelay=True))
         self.sampler = self._sampler(spec)
         self.load_error = ""
         rospy.loginfo("rubass: enforcing %s (%s)", spec.path, ", ".join(  # distinct topics
@@ -328,20 +340,9 @@ class Monitor(Reloading):
         self.master_watch = MasterWatch(rospy.get_caller_id(), rospy.core.get_node_uri(), rosgraph.get_master_uri(),
                                         1.0 / self.config.master_rate, _log, unreachable=self._unreachable_means)
         self.master_watch.start()
-        threading.Thread(target=self._advertise_services, name="rubass-services", daemon=True).start()
-
-    def _advertise_services(self) -> None:
-        try:
-            rospy.Service("~reload", Trigger, lambda req: TriggerResponse(*self.reload("service")))
-            rospy.Service("~reset", Trigger, lambda req: TriggerResponse(*self.reset()))
-        except Exception as exc:  # noqa: BLE001 - SIGHUP still reloads; the rules are enforced either way
-            _log("error", f"rubass: cannot offer ~reload and ~reset: {exc.__class__.__name__}: {exc}")
-
-    def _subscribe_agents(self) -> None:
-        try:
-            rospy.Subscriber(AGENT_TOPIC, String, self._on_agent, queue_size=100, tcp_nodelay=True)
-        except Exception as exc:  # noqa: BLE001 - the nodes of other hosts then read unknown, and say why
-            _log("error", f"rubass: cannot subscribe to {AGENT_TOPIC}: {exc.__class__.__name__}: {exc}")
+        _register_aside("offer ~reload and ~reset", lambda: (  # SIGHUP reloads meanwhile
+            rospy.Service("~reload", Trigger, lambda req: TriggerResponse(*self.reload("service"))),
+            rospy.Service("~reset", Trigger, lambda req: TriggerResponse(*self.reset()))))
 
     def _unreachable_means(self) -> str:
         """What a master that stops answering means for the robot, as the monitor stands."""
