@@ -20,12 +20,35 @@ pytestmark = pytest.mark.ros
 PY = "/usr/bin/python3"
 
 
-def _big_spec(path, limit, rules=6000):
-    """A spec that takes about a second to read here, with one real rule at `limit`."""
+def _big_spec(path, limit=1, rules=6000, watchdog=False):
+    """A spec that takes about a second to read here, with one real rule: /speed over `limit` brakes, or
+    (`watchdog`) /cmd_vel silent for 1 s stops, which needs no master."""
     lines = ['import "lib.yaml";', "action primitive stop, brake, warn;", "entity f { rules:"]
     lines += [f"  r{i}: topic /filler{i % 50}.data > {i};" for i in range(rules)]
-    lines += ["}", f"entity base {{ rules: fast: topic /speed.data > {limit}; }}", "if (base.fast) then { brake; }"]
+    lines += ["}"] + (["entity base { rules: stale: age(topic /cmd_vel) > 1 s; }", "if (base.stale) then { stop; }"]
+                      if watchdog else [f"entity base {{ rules: fast: topic /speed.data > {limit}; }}",
+                                        "if (base.fast) then { brake; }"])
     path.write_text("\n".join(lines) + "\n")
+
+
+def _monitor_reading(ros, tmp_path, lib=None, **spec):
+    """A monitor started on a big spec (`_big_spec(**spec)`), returned once its node is registered: it
+    reads the spec for about a second next. Its spec's path too."""
+    (tmp_path / "lib.yaml").write_text(lib or rosharness.LIB)
+    path = tmp_path / "s.rbs"
+    _big_spec(path, **spec)
+    mon = ros.monitor(str(path), wait=False)
+    _wait_registered(ros, mon)
+    return mon, path
+
+
+LONG = 20000  # rules: read in about a second on an idle machine (6,000 took 0.3 s, and the master was stopped late)
+
+
+def _lose_the_master_while_the_spec_is_read(ros):
+    """For a monitor reading a spec of LONG rules: the parameters are read by then (a few ms)."""
+    time.sleep(0.3)
+    ros.master.stop()
 
 
 def _registered(ros, name="/rubass"):
@@ -55,11 +78,7 @@ def _speed_brakes(ros, value):
 
 
 def test_an_edit_saved_and_signalled_while_the_spec_is_read_is_enforced(ros, tmp_path):
-    (tmp_path / "lib.yaml").write_text(rosharness.LIB)
-    spec = tmp_path / "s.rbs"
-    _big_spec(spec, 100)  # lenient
-    mon = ros.monitor(str(spec), wait=False)
-    _wait_registered(ros, mon)
+    mon, spec = _monitor_reading(ros, tmp_path, limit=100)  # lenient
     time.sleep(0.1)  # reading the spec now (about a second)
     _big_spec(spec, 1)  # the engineer's stricter edit, saved, then SIGHUP
     mon.send_signal(signal.SIGHUP)
@@ -73,11 +92,7 @@ def test_an_edit_saved_and_signalled_while_the_spec_is_read_is_enforced(ros, tmp
 
 
 def test_a_sigterm_while_the_spec_is_read_ends_the_monitor_cleanly_and_unregistered(ros, tmp_path):
-    (tmp_path / "lib.yaml").write_text(rosharness.LIB)
-    spec = tmp_path / "s.rbs"
-    _big_spec(spec, 100)
-    mon = ros.monitor(str(spec), wait=False)
-    _wait_registered(ros, mon)
+    mon, _ = _monitor_reading(ros, tmp_path, limit=100)
     time.sleep(0.1)
     mon.send_signal(signal.SIGTERM)
     assert mon.wait(20) == 0, ros.log(mon)  # was -15, no line
@@ -154,13 +169,8 @@ def test_a_stop_asked_while_a_hung_master_holds_the_parameters_ends_the_process(
 def test_a_sigterm_while_the_start_waits_for_the_master_ends_the_monitor(ros, tmp_path):
     """A re-sweep: a SIGTERM while the actions' publishers waited for a master that was down was kept
     until the master came back (27 s and more; for good if it never did)."""
-    (tmp_path / "lib.yaml").write_text(rosharness.LIB)
-    spec = tmp_path / "s.rbs"
-    _big_spec(spec, 1)
-    mon = ros.monitor(str(spec), wait=False)
-    _wait_registered(ros, mon)
-    time.sleep(0.3)
-    ros.master.stop()
+    mon, _ = _monitor_reading(ros, tmp_path, rules=LONG)
+    _lose_the_master_while_the_spec_is_read(ros)
     rosharness.wait_log(mon, ros, "setting up the actions takes over a second", timeout=30)
     t0 = time.monotonic()
     mon.send_signal(signal.SIGTERM)
@@ -195,25 +205,12 @@ LOG_LIB = """actions:
 """
 
 
-def _stale_spec(path, rules=6000):
-    """A spec that takes about a second to read, with a watchdog needing no master: /cmd_vel silent for 1 s."""
-    lines = ['import "lib.yaml";', "action primitive stop, brake, warn;", "entity f { rules:"]
-    lines += [f"  r{i}: topic /filler{i % 50}.data > {i};" for i in range(rules)]
-    lines += ["}", "entity base { rules: stale: age(topic /cmd_vel) > 1 s; }", "if (base.stale) then { stop; }"]
-    path.write_text("\n".join(lines) + "\n")
-
-
 def test_a_master_lost_while_the_spec_is_read_does_not_hold_the_rules_unenforced(ros, tmp_path):
     """CI found it: a master that went down in the monitor's start, after the spec was read, held the
     start in rospy's registration of ~reload (and of the agents' topic) until the master came back: no
     rule was enforced meanwhile, while the master watch said "the rules keep being enforced"."""
-    (tmp_path / "lib.yaml").write_text(LOG_LIB)
-    spec = tmp_path / "s.rbs"
-    _stale_spec(spec)
-    mon = ros.monitor(str(spec), wait=False)
-    _wait_registered(ros, mon)
-    time.sleep(0.3)  # the parameters are read (a few ms); the spec is being read (about a second)
-    ros.master.stop()
+    mon, _ = _monitor_reading(ros, tmp_path, LOG_LIB, rules=LONG, watchdog=True)
+    _lose_the_master_while_the_spec_is_read(ros)
     rosharness.wait_log(mon, ros, "rubass: enforcing", timeout=30)
     rosharness.wait_log(mon, ros, "STOP-LOGGED", timeout=10)  # the watchdog, with the master still down
     assert "the rules keep being enforced" not in ros.log(mon).split("rubass: enforcing")[0], ros.log(mon)
@@ -225,13 +222,8 @@ def test_a_master_lost_while_the_spec_is_read_does_not_hold_the_rules_unenforced
 def test_a_master_lost_before_the_actions_are_set_up_is_said_and_enforcing_follows_its_return(ros, tmp_path):
     """Publish actions register with the master; while it is down the start waits there: said, with NO
     RULE IS ENFORCED (rospy said only "Unable to register"), and enforcing follows the master's return."""
-    (tmp_path / "lib.yaml").write_text(rosharness.LIB)
-    spec = tmp_path / "s.rbs"
-    _big_spec(spec, 1)
-    mon = ros.monitor(str(spec), wait=False)
-    _wait_registered(ros, mon)
-    time.sleep(0.3)  # the parameters are read (a few ms); the spec is being read (about a second)
-    ros.master.stop()
+    mon, _ = _monitor_reading(ros, tmp_path, rules=LONG)
+    _lose_the_master_while_the_spec_is_read(ros)
     rosharness.wait_log(mon, ros, "setting up the actions takes over a second", timeout=30)
     log = ros.log(mon)
     assert "NO RULE IS ENFORCED until it is done" in log and "rubass: enforcing" not in log, log
