@@ -49,3 +49,9 @@ def above_zero(kind, zero_ok=False):
 
     parse.__name__ = kind.__name__
     return parse
+
+
+def receiver_option(ap):
+    """`--receiver`: the monitor's ~receiver for this run (docs/monitor.md), to compare its two ways of reading."""
+    ap.add_argument("--receiver", choices=("one_thread", "rospy"), default="one_thread",
+                    help="the monitor's ~receiver (default one_thread; rospy: a rospy thread per connection)")

@@ -14,6 +14,7 @@ publishing window is divided by the messages published in it. Cases:
 Targets: ratio <= 1.5 in (a) and (b); in (c) the monitor keeps up to >= 80 % of the bare rate.
 (c) publishes from up to 5 processes, all of them on the same machine as the subscribers.
 Prints one JSON object per case. Usage: bench/cpu.py [--seconds S] [--cases abc] [--smoke]
+[--receiver one_thread|rospy] (the monitor's ~receiver, to compare its two ways of reading)
 """
 import argparse
 import json
@@ -115,7 +116,7 @@ def _detail(pid):
     return t.user, t.system, switches
 
 
-def run_case(master, tmp, profile, spec, scale, seconds, parts=1):
+def run_case(master, tmp, profile, spec, scale, seconds, parts=1, receiver="one_thread"):
     """One run: monitor and bare subscriber together, publishing at `scale` x the profile's rates
     from `parts` publisher processes (one Python publisher tops out at about 6,000 messages/s)."""
     bare = mon = None
@@ -123,7 +124,7 @@ def run_case(master, tmp, profile, spec, scale, seconds, parts=1):
     try:
         bare = subprocess.Popen([PY, PEER, "bare", profile], env=master.env, stdout=subprocess.PIPE,
                                 stderr=subprocess.DEVNULL, text=True, start_new_session=True)
-        mon, _ = start_monitor(master, tmp, spec)
+        mon, _ = start_monitor(master, tmp, spec, receiver=receiver)
         for part in range(parts):
             pubs.append(subprocess.Popen([PY, PEER, "pub", profile, str(scale), str(seconds), "2", str(part), str(parts)],
                                          env=master.env, stdin=subprocess.PIPE, stdout=subprocess.PIPE,
@@ -168,11 +169,11 @@ def run_case(master, tmp, profile, spec, scale, seconds, parts=1):
     }
 
 
-def ramp(master, tmp, profile, spec, seconds, scales, parts):
+def ramp(master, tmp, profile, spec, seconds, scales, parts, receiver):
     """Each scale in turn until both lose messages or the publisher falls behind its schedule."""
     steps, kept = [], {"monitor": 0.0, "bare": 0.0}
     for scale in scales:
-        r = run_case(master, tmp, profile, spec, scale, seconds, parts)
+        r = run_case(master, tmp, profile, spec, scale, seconds, parts, receiver)
         r["scale"] = scale
         steps.append(r)
         for who in kept:
@@ -201,6 +202,7 @@ def main():
                     help="publishing window per run (default 10)")
     ap.add_argument("--cases", default="abc", help="which of a, b, c (default abc)")
     ap.add_argument("--smoke", action="store_true", help="tiny sizes, to check it works")
+    _common.receiver_option(ap)
     args = ap.parse_args()
     if not args.cases or set(args.cases) - set("abc"):
         ap.error(f"argument --cases: letters of a, b and c (e.g. ab), not {args.cases!r}")
@@ -212,17 +214,18 @@ def main():
             cases = [("a", a_profile, a_spec), ("b", "b", spec_b())]
             for name, profile, spec in cases:
                 if name in args.cases:
-                    r = run_case(master, tmp, profile, spec, 1.0, seconds)
-                    print(json.dumps({"benchmark": "cpu", "case": name, **r,
+                    r = run_case(master, tmp, profile, spec, 1.0, seconds, receiver=args.receiver)
+                    print(json.dumps({"benchmark": "cpu", "case": name, "receiver": args.receiver, **r,
                                       "target_ratio_le_1.5": r["ratio"] is not None and r["ratio"] <= 1.5,
                                       **_common.machine()}), flush=True)
             if "c" in args.cases:
                 for name, profile, spec in cases:
                     scales = [1.0] if args.smoke else [1, 2, 4, 8, 16, 32]
                     parts = 1 if args.smoke else len(_topics(profile))
-                    steps, kept = ramp(master, tmp, profile, spec, min(seconds, 5.0), scales, min(parts, 5))
+                    steps, kept = ramp(master, tmp, profile, spec, min(seconds, 5.0), scales, min(parts, 5),
+                                       args.receiver)
                     ok = kept["bare"] > 0 and kept["monitor"] >= 0.8 * kept["bare"]
-                    print(json.dumps({"benchmark": "cpu", "case": "c", "profile": name,
+                    print(json.dumps({"benchmark": "cpu", "case": "c", "profile": name, "receiver": args.receiver,
                                       "monitor_kept_msgs_per_s": kept["monitor"], "bare_kept_msgs_per_s": kept["bare"],
                                       "target_monitor_ge_0.8_bare": ok, "steps": steps, **_common.machine()}), flush=True)
         finally:

@@ -12,7 +12,7 @@ At 100 Hz and 1 kHz, alone and with background load (20 other topics at 100 Hz a
 other rules in the monitor). Prints one JSON object per case, with p50/p99/max of (a) and
 (b) and the ratio (b) / 2·(a) at the median. Targets: (b) p50 <= 2x the two raw hops and
 (b) p99 <= 3 ms under the background load.
-Usage: bench/reaction.py [--seconds S] [--smoke]
+Usage: bench/reaction.py [--seconds S] [--smoke] [--receiver one_thread|rospy]
 """
 import argparse
 import json
@@ -26,13 +26,14 @@ from _rosbench import PY, PEER, PrivateMaster, run_peer, spec_text, start_load, 
 LOAD_TOPICS, LOAD_RULES = 20, 100
 
 
-def measure(master, tmp, mode, hz, seconds, loaded):
+def measure(master, tmp, mode, hz, seconds, loaded, receiver="one_thread"):
     procs = start_load(master, LOAD_TOPICS, 100) if loaded else []
     try:
         if mode == "raw":
             procs.append(master.spawn([PY, PEER, "echo"]))
         else:
-            procs.append(start_monitor(master, tmp, spec_text(LOAD_TOPICS, LOAD_RULES if loaded else 0))[0])
+            procs.append(start_monitor(master, tmp, spec_text(LOAD_TOPICS, LOAD_RULES if loaded else 0),
+                                       receiver=receiver)[0])
         return run_peer(master, ["driver", mode, str(hz), str(seconds)], seconds + 60)
     finally:
         stop_processes(procs)
@@ -48,6 +49,7 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--seconds", type=_common.above_zero(float), default=5.0, help="per case (default 5)")
     ap.add_argument("--smoke", action="store_true", help="one short case (100 Hz, 0.5 s), to check it works")
+    _common.receiver_option(ap)
     args = ap.parse_args()
     cases = [(100, False)] if args.smoke else [(100, False), (1000, False), (100, True), (1000, True)]
     seconds = 0.5 if args.smoke else args.seconds
@@ -56,11 +58,11 @@ def main():
         try:
             for hz, loaded in cases:
                 raw = measure(master, tmp, "raw", hz, seconds, loaded)
-                rb = measure(master, tmp, "rubass", hz, seconds, loaded)
+                rb = measure(master, tmp, "rubass", hz, seconds, loaded, args.receiver)
                 a, b = summary(raw["latencies"]), summary(rb["latencies"])
                 ratio = b["p50_ms"] / (2 * a["p50_ms"]) if a["p50_ms"] else None
                 print(json.dumps({
-                    "benchmark": "reaction", "rate_hz": hz, "background_load": loaded, "seconds": seconds,
+                    "benchmark": "reaction", "receiver": args.receiver, "rate_hz": hz, "background_load": loaded, "seconds": seconds,
                     "smoke": args.smoke,  # `rubass report --bench` refuses a smoke run: it measures nothing
                     "raw_hop": a, "rubass": b, "rubass_unanswered": rb["unanswered"],
                     "rubass_extra_stops": rb.get("extra_stops", 0),

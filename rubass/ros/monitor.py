@@ -79,6 +79,7 @@ from .timerslack import exact_timers
 from .priority import describe, thread_nice_values
 from .exiting import EXIT_GRACE, exit_within
 from .reloading import ConfigError, Reloading, StartupError, said_if_slow
+from . import receiver
 from .topics import TopicWatcher, ros_now
 
 
@@ -319,7 +320,9 @@ class Monitor(Reloading):
             self._on_events(hold(latch.actions, f"restored: {latch.holder}", now), "reload")
         self._on_events(engine.evaluate_all(now), "reload")
         self.keeper.save(engine, self.dispatcher.orphans, self._fail_safes())
-        self.watcher = TopicWatcher(self._on_message, _log, self._on_spellings)
+        # one thread reads every watched topic's connections (issue 17; rospy's threads where it cannot)
+        reader = receiver.install(_log) if self.config.receiver == "one_thread" else None
+        self.watcher = TopicWatcher(self._on_message, _log, self._on_spellings, reader)
         self.watcher.sync(spec)
         self.livecheck = LiveTypeCheck(_log)  # the spec against the types its topics turn out to carry
         self.agents = AgentBook()  # cpu and memory of nodes on other hosts, from their agents
@@ -521,6 +524,7 @@ class Monitor(Reloading):
             "master": self.master_watch.state, "master re-registrations": self.master_watch.reregistrations,
             "reaction latency p50 ms": f"{lat[len(lat) // 2] * 1000:.3f}" if lat else "n/a",
             "nice": self._nice(),
+            "receiving": self.watcher.receiving(self.config.receiver),
             "agents": self.agents.summary(time.monotonic()),
             "silent agents": ", ".join(self.agents.silent(time.monotonic())) or "none",
             "agents claiming one host": "; ".join(self.agents.conflicts(time.monotonic())) or "none",

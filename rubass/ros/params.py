@@ -33,6 +33,7 @@ class MonitorConfig:
     state_file: Optional[str] = None  # latched actions kept across restarts; None: off
     error_actions: List[str] = field(default_factory=list)  # run while a field cannot be read
     nice: Optional[int] = None  # the threads' nice value (-20 to 19); None: as started (priority.py)
+    receiver: str = "one_thread"  # who reads the watched topics: one thread (receiver.py) or "rospy"'s threads
     # ~spec and ~actions paths given relative: ("~spec '../safety.rbs'", the absolute path made from `cwd`,
     # the working directory: $ROS_HOME under roslaunch), for the note a failed read gets (relative_note)
     relative: Tuple[Tuple[str, str], ...] = ()
@@ -40,7 +41,9 @@ class MonitorConfig:
 
 
 KNOWN = ("spec", "actions", "rate", "node_rate", "diagnostics_rate", "master_rate", "overload_actions",
-         "queue_size", "error_actions", "state_file", "nice")
+         "queue_size", "error_actions", "state_file", "nice", "receiver")
+
+RECEIVERS = ("one_thread", "rospy")
 
 # `rosrun rubass monitor --help`: each parameter with its type, default and range (read_config checks them)
 HELP = """  ~spec (string, required)          the RuBaSS spec to enforce
@@ -56,6 +59,8 @@ HELP = """  ~spec (string, required)          the RuBaSS spec to enforce
                                     monitor's restarts; false: none kept (WARN in /diagnostics)
   ~nice (int, -20 to 19, as started)  the monitor's scheduling priority, e.g. -10 on a busy
                                     computer (below the current value: root or CAP_SYS_NICE)
+  ~receiver (one_thread or rospy, one_thread)  who reads the watched topics' messages: one
+                                    thread for all (less CPU), or a rospy thread per connection
 Private parameters stay on the master after the monitor stops: a later rosrun reads them again
 (rosparam get /rubass; rosparam delete /rubass/NAME).
 """
@@ -166,6 +171,10 @@ def read_config(get: Getter, default_state_file: Optional[str] = None) -> Monito
     nice = get("nice", None)
     if nice is not None and (not isinstance(nice, int) or isinstance(nice, bool) or not -20 <= nice <= 19):
         raise ParamError(f"~nice must be a whole number from -20 (highest priority) to 19, got {nice!r}")
+    receiver = get("receiver", "one_thread")
+    if receiver not in RECEIVERS:
+        raise ParamError(f"~receiver must be one_thread (one thread reads every watched topic) or rospy (a rospy "
+                         f"thread per connection, as rospy subscribers do), got {receiver!r}")
     relative: List[Tuple[str, str]] = []
     return MonitorConfig(
         spec=_path("spec", spec, relative),
@@ -179,6 +188,7 @@ def read_config(get: Getter, default_state_file: Optional[str] = None) -> Monito
         state_file=_state_file(get, default_state_file),
         error_actions=error_actions,
         nice=nice,
+        receiver=receiver,
         relative=tuple(relative),
         cwd=os.getcwd() if relative else "",  # read above for the first of them
     )

@@ -2,7 +2,9 @@
 type. The type comes from each connection's header; messages are deserialised only for
 topics whose fields the spec reads; field paths are checked when a topic's type is first
 seen (and again when it changes; two types at once: topictypes.py). Subscriptions are made
-in the background (see TopicWatcher), never under a lock the engine or a callback takes."""
+in the background (see TopicWatcher), never under a lock the engine or a callback takes. Their
+connections are read by the receiver's one thread (receiver.py), which calls `_on_frame` with
+each message's bytes; rospy's threads call `_callback` where the receiver gives a connection back."""
 from __future__ import annotations
 
 import queue
@@ -23,6 +25,7 @@ from ..lang.model import CheckedSpec
 from . import topictypes
 from .clockjump import ClockStall
 from .msgtypes import check_path
+from .receiver import Receiver
 from .topictypes import RECHECK
 
 _rostime = rospy.rostime
@@ -88,8 +91,10 @@ class TopicWatcher:
 
     SLOW = 1.0  # s: a registration that takes longer is logged (the master does not answer)
 
-    def __init__(self, submit: Submit, log: Log, submit_spellings: Optional[SubmitAll] = None) -> None:
+    def __init__(self, submit: Submit, log: Log, submit_spellings: Optional[SubmitAll] = None,
+                 receiver: Optional[Receiver] = None) -> None:
         self.submit = submit
+        self.receiver = receiver  # one thread reads every watched topic (receiver.py); None: rospy's threads
         # every spelling of one message at one instant (one evaluation); without it, one submit each
         self.submit_spellings = submit_spellings
         self.log = log
@@ -186,6 +191,7 @@ class TopicWatcher:
                 elif state.subscriber is not None:
                     sub, state.subscriber = state.subscriber, None
                     sub.unregister()
+                    self._unroute(state)
             except Exception as exc:  # noqa: BLE001 - the registrar serves every later job
                 self.log("error", f"topic {state.resolved}: cannot {kind}: {exc.__class__.__name__}: {exc}")
 
@@ -206,6 +212,8 @@ class TopicWatcher:
         slow.daemon = True
         t0 = time.monotonic()
         slow.start()
+        if self.receiver is not None:
+            self.receiver.route(state.resolved, self._callback, self._on_frame, state)
         try:
             sub = rospy.Subscriber(state.resolved, rospy.AnyMsg, self._callback, callback_args=state,
                                    tcp_nodelay=True)
@@ -218,8 +226,21 @@ class TopicWatcher:
                 state.subscriber = sub
         if not keep:  # dropped by a reload (or closed) while it waited for the master
             sub.unregister()
+            self._unroute(state)
         elif took > self.SLOW:
             self.log("info", f"topic {state.resolved}: subscribed after {took:.1f} s (the master answers again)")
+
+    def receiving(self, chosen: str) -> str:
+        """Who reads the watched topics' connections, for /diagnostics (`chosen`: ~receiver)."""
+        if self.receiver is not None:
+            return self.receiver.describe()
+        if chosen == "rospy":
+            return "rospy's threads (~receiver: rospy)"
+        return "rospy's threads (this rospy connects subscribers differently, see the log)"
+
+    def _unroute(self, state: TopicState) -> None:
+        if self.receiver is not None:
+            self.receiver.unroute(state.resolved, state)
 
     def close(self, wait: float = 1.0) -> None:
         """Drop every subscription (by the registrar: a master that does not answer cannot hold
@@ -250,6 +271,11 @@ class TopicWatcher:
                 self.submit(alias, now, msg, wall, 0)
 
     def _callback(self, raw: Any, state: TopicState) -> None:
+        """A message through rospy's own delivery (an rospy.AnyMsg)."""
+        self._on_frame(raw._buff, getattr(raw, "_connection_header", None) or {}, state)
+
+    def _on_frame(self, buff: bytes, header: Dict[str, str], state: TopicState) -> None:
+        """One message of a watched topic: its serialised bytes and its connection's header."""
         wall = time.time()
         now = wall if _rostime._rostime_current is None and _rostime._rostime_initialized else ros_now()
         state.messages += 1
@@ -258,7 +284,6 @@ class TopicWatcher:
         if not state.paths:
             self._send(state, now, None, wall, 0)  # age/frequency only: never deserialised
             return
-        header = getattr(raw, "_connection_header", None) or {}
         md5 = header.get("md5sum", "")
         md5_now, cls, type_name, unreadable = state.decoder
         if md5 != md5_now or (state.mixed is not None and wall - state.checked >= RECHECK):
@@ -273,7 +298,7 @@ class TopicWatcher:
             self._send(state, now, UNREADABLE, wall, 0)
             return
         try:
-            msg = cls().deserialize(raw._buff)  # this message's own type's class (review: not state.cls)
+            msg = cls().deserialize(buff)  # this message's own type's class (review: not state.cls)
         except (genpy.DeserializationError, ValueError, TypeError, IndexError, Exception) as exc:
             if not state.errors or not state.errors[-1].startswith("cannot deserialise"):
                 state.errors.append(f"cannot deserialise a {type_name} message: {exc}")
@@ -282,7 +307,7 @@ class TopicWatcher:
         else:
             if state.errors and state.errors[-1].startswith("cannot deserialise"):
                 state.errors.pop()  # readable again: the error lasted until this message
-        self._send(state, now, msg, wall, len(raw._buff) if msg is not UNKNOWN else 0)
+        self._send(state, now, msg, wall, len(buff) if msg is not UNKNOWN else 0)
 
     def _new_kind(self, state: TopicState, header: Dict[str, str]) -> topictypes.Kind:
         """A type not seen on this topic yet: its class, and what the rules cannot read in it (logged)."""

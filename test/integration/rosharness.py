@@ -149,3 +149,12 @@ def brake_after(ros, value, wait=1.0, grace=0.0):
                                {"publish": "/cmd_vel", "msg": {"linear": {"x": value}}}, {"sleep": wait}]})
     go = next(r["wall"] for r in rec if r["kind"] == "mark")
     return [r for r in rec if r["kind"] == "recv" and r["wall"] > go + grace and r["msg"]["data"] is True]
+
+
+def monitor_values(ros):
+    """The key/values of the monitor's own /diagnostics status (`rubass: monitor`), its latest."""
+    rec = ros.probe({"listen": [{"topic": "/diagnostics", "type": "diagnostic_msgs/DiagnosticArray"}],
+                     "steps": [{"wait": "/diagnostics", "timeout": 10}, {"sleep": 1.2}]})
+    mons = [s for r in rec if r["kind"] == "recv" for s in r["msg"]["status"] if s["name"] == "rubass: monitor"]
+    assert mons
+    return {kv["key"]: kv["value"] for kv in mons[-1]["values"]}

@@ -19,6 +19,7 @@ def test_cpu_benchmark_smoke():
     assert out.returncode == 0, out.stderr
     rows = [json.loads(line) for line in out.stdout.splitlines()]
     assert [(r["case"], r.get("profile")) for r in rows] == [("a", None), ("b", None), ("c", "a"), ("c", "b")]
+    assert {r["receiver"] for r in rows} == {"one_thread"}  # the monitor's default ~receiver
     for r in rows[:2]:
         # every message published reached both subscribers, and both spent CPU on them
         assert r["published"] > 0 and r["bare_received"] == r["published"]

@@ -95,3 +95,4 @@ def test_ros_args_lists_only_spec_as_required():
     required = out.stdout.split("Optional Arguments:")[0]
     assert "spec:" in required and "nice:" not in required and "state_file:" not in required, out.stdout
     assert "  nice (default \"as_started\")" in out.stdout and "  state_file (default \"default\")" in out.stdout
+    assert "  receiver (default \"one_thread\")" in out.stdout, out.stdout

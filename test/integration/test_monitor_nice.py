@@ -7,21 +7,13 @@ import shutil
 import tempfile
 
 import pytest
-from rosharness import PY, brake_after, spec
+from rosharness import PY, brake_after, monitor_values, spec
 
 from conftest import ROOT
 
 pytestmark = [pytest.mark.ros, pytest.mark.slow]
 
 SPEC = "entity a { rules:\n  fast: topic /cmd_vel.linear.x > 1;\n}\nif (a.fast) then { brake; }\n"
-
-
-def monitor_values(ros):
-    rec = ros.probe({"listen": [{"topic": "/diagnostics", "type": "diagnostic_msgs/DiagnosticArray"}],
-                     "steps": [{"wait": "/diagnostics", "timeout": 10}, {"sleep": 1.2}]})
-    mons = [s for r in rec if r["kind"] == "recv" for s in r["msg"]["status"] if s["name"] == "rubass: monitor"]
-    assert mons
-    return {kv["key"]: kv["value"] for kv in mons[-1]["values"]}
 
 
 def thread_nice_values(pid):

@@ -38,3 +38,19 @@ def test_the_docs_table_states_the_queue_size_range():
     text = open(os.path.join(ROOT, "docs", "monitor.md")).read()
     assert "| `~queue_size` | int, 10 to 10000000 | 100000 |" in text
     assert "Private parameters stay on the master" in text
+
+
+@pytest.mark.parametrize("value", ["one_thread", "rospy"])
+def test_the_receiver_is_one_of_its_two_values(value):
+    assert config().receiver == "one_thread"  # the default
+    assert config(receiver=value).receiver == value
+
+
+@pytest.mark.parametrize("bad", ["threads", "", 1, True, None, ["rospy"]])
+def test_any_other_receiver_is_refused_with_both_values_named(bad):
+    with pytest.raises(ParamError) as err:
+        config(receiver=bad)
+    assert str(err.value) == (f"~receiver must be one_thread (one thread reads every watched topic) or rospy (a rospy "
+                              f"thread per connection, as rospy subscribers do), got {bad!r}")
+    text = open(os.path.join(ROOT, "docs", "monitor.md")).read()
+    assert "| `~receiver` | `one_thread` or `rospy` | `one_thread` |" in text

@@ -1,0 +1,114 @@
+"""The monitor's receiver on a live system (rubass/ros/receiver.py, issue 17): one thread reads
+every watched topic, through publishers that come and go, latched and large messages, a `limit`
+action reading a topic the spec reads too, and `~receiver: rospy` for rospy's own threads."""
+import json
+import subprocess
+import time
+
+import pytest
+from rosharness import PY, TWIST, brake_after, monitor_values, spec
+
+pytestmark = [pytest.mark.ros, pytest.mark.slow]
+
+FAST = "entity a { rules:\n  fast: topic /cmd_vel.linear.x > 1;\n}\nif (a.fast) then { brake; }\n"
+
+
+def until_value(ros, key, want, timeout=10.0):
+    end, got = time.monotonic() + timeout, None
+    while time.monotonic() < end:
+        got = monitor_values(ros)[key]
+        if got == want:
+            return
+    raise AssertionError(f"{key}: {got!r}, never {want!r}")
+
+
+def test_one_thread_reads_the_topics_and_publishers_may_come_and_go(ros, tmp_path):
+    mon = ros.monitor(spec(tmp_path, FAST))
+    # each brake_after is a new publisher node: a new connection (the master's publisherUpdate),
+    # and its end when the node exits
+    for _ in range(3):
+        assert brake_after(ros, 2.0), ros.log(mon)
+        assert not brake_after(ros, 0.5, grace=0.3), ros.log(mon)
+    until_value(ros, "receiving", "one thread, 0 connections")  # every ended publisher's connection dropped
+    assert "Traceback" not in ros.log(mon) and "receiver:" not in ros.log(mon), ros.log(mon)
+
+
+LATCHED = """
+import rospy, sys
+from std_msgs.msg import Float64, UInt8MultiArray
+rospy.init_node(sys.argv[1])
+if sys.argv[1] == "latched":
+    pub = rospy.Publisher("/mode", Float64, queue_size=1, latch=True)
+    pub.publish(Float64(3.0))
+else:
+    pub = rospy.Publisher("/big", UInt8MultiArray, queue_size=1, tcp_nodelay=True)
+    while pub.get_num_connections() == 0:
+        rospy.sleep(0.05)
+    rospy.sleep(0.5)
+    pub.publish(UInt8MultiArray(data=bytes(range(256)) * 16384))  # 4 MiB: many reads
+print("published", flush=True)
+rospy.spin()
+"""
+
+
+def test_a_latched_message_sent_before_the_monitor_started_and_a_4_mib_message_are_read(ros, tmp_path):
+    latched = ros.spawn([PY, "-c", LATCHED, "latched"], "latched", stdout=subprocess.PIPE, text=True)
+    assert latched.stdout.readline().strip() == "published"
+    body = ("entity a { rules:\n  mode: topic /mode.data > 2;\n  big: len(topic /big.data) > 4000000;\n}\n"
+            "if (a.mode) then { warn; }\nif (a.big) then { brake; }\n")
+    mon = ros.monitor(spec(tmp_path, body))
+    listener = ros.probe_bg({"listen": [{"topic": "/brake", "type": "std_msgs/Bool"}],
+                             "steps": [{"wait_publishers": "/brake"}, {"mark": "ready"},
+                                       {"wait": "/brake", "timeout": 20}], "linger": 0.1}, name="listener")
+    assert '"ready"' in listener.stdout.readline()
+    big = ros.spawn([PY, "-c", LATCHED, "big"], "big", stdout=subprocess.PIPE, text=True)
+    assert big.stdout.readline().strip() == "published"
+    out, _ = listener.communicate(timeout=30)
+    got = [json.loads(x) for x in out.splitlines() if x.startswith("{")]
+    assert any(r["kind"] == "recv" and r["msg"]["data"] is True for r in got), ros.log(mon)
+    started = [x for x in ros.log(mon).splitlines() if x.startswith("[WARN]") and "started" in x]
+    assert len(started) == 1 and "a.mode" in started[0], ros.log(mon)  # the latched 3.0 started `warn`
+    assert monitor_values(ros)["receiving"] == "one thread, 2 connections"
+
+
+CRAWL = ("actions:\n  crawl:\n    plugin: limit\n    input: /cmd_vel\n    topic: /safety_cmd\n"
+         "    linear_x: [-0.1 m/s, 0.2 m/s]\n"
+         "  brake: {plugin: publish, topic: /brake, type: std_msgs/Bool, message: {data: true}, rate: 20 Hz}\n")
+
+
+def test_a_limit_action_reading_a_topic_of_the_spec_gets_it_on_a_rospy_thread_and_both_work(ros, tmp_path):
+    """The `limit` action publishes from its callback: that topic's connection is never the receiver's."""
+    (tmp_path / "lib.yaml").write_text(CRAWL)
+    path = tmp_path / "s.rbs"
+    path.write_text('import "lib.yaml";\naction primitive crawl, brake;\n'
+                    "entity a { rules:\n  fast: topic /cmd_vel.linear.x > 1;\n  on: topic /trig.data > 0;\n}\n"
+                    "if (a.on) then { crawl; }\nif (a.fast) then { brake; }\n")
+    mon = ros.monitor(str(path))
+    rec = ros.probe({
+        "listen": [{"topic": "/safety_cmd", "type": TWIST}, {"topic": "/brake", "type": "std_msgs/Bool"}],
+        "advertise": [{"topic": "/cmd_vel", "type": TWIST}, {"topic": "/trig", "type": "std_msgs/Float64"}],
+        "steps": [{"wait_subscribers": "/cmd_vel"}, {"wait_subscribers": "/trig"}, {"wait_publishers": "/safety_cmd"},
+                  {"wait_publishers": "/brake"}, {"sleep": 0.5},
+                  {"publish": "/trig", "msg": {"data": 1.0}}, {"sleep": 0.3}, {"mark": "go"},
+                  {"publish": "/cmd_vel", "msg": {"linear": {"x": 2.0}}, "repeat": 5, "period": 0.05},
+                  {"sleep": 0.5}], "linger": 0.1})
+    go = next(r["wall"] for r in rec if r["kind"] == "mark")
+    clamped = [r["msg"]["linear"]["x"] for r in rec if r["kind"] == "recv" and r["topic"] == "/safety_cmd"
+               and r["wall"] > go]
+    assert clamped and max(clamped) == pytest.approx(0.2), (clamped, ros.log(mon))
+    assert any(r["kind"] == "recv" and r["topic"] == "/brake" and r["wall"] > go for r in rec), ros.log(mon)
+    values = monitor_values(ros)
+    # the probe has ended: both its connections too; /cmd_vel's was read by a rospy thread
+    assert values["receiving"] == "one thread, 0 connections, 1 given to rospy's threads", values
+
+
+def test_receiver_rospy_keeps_rospys_threads_and_a_bad_value_is_refused(ros, tmp_path):
+    mon = ros.monitor(spec(tmp_path, FAST), receiver="rospy")
+    assert brake_after(ros, 2.0), ros.log(mon)
+    assert monitor_values(ros)["receiving"] == "rospy's threads (~receiver: rospy)"
+    bad = ros.monitor(spec(tmp_path, FAST, name="t.rbs"), name="rubass2", wait=False, receiver="threads")
+    assert bad.wait(20) == 1
+    log = ros.log(bad)
+    assert ("~receiver must be one_thread (one thread reads every watched topic) or rospy (a rospy thread per "
+            "connection, as rospy subscribers do), got 'threads'") in log, log
+    assert "Traceback" not in log
