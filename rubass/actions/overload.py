@@ -1,8 +1,10 @@
 """Failing safe when the monitor cannot keep up.
 
 A monitor whose engine queue is full drops messages, and a dropped message may be the one
-that shows a violation. With `~overload_actions` set (e.g. `[stop]`), the monitor runs those
-actions as soon as a message is dropped, and releases them once no message has been dropped
+that shows a violation; a monitor whose receiving thread cannot keep up reads its messages late
+(they wait in the sockets' buffers, `behind` seconds): the robot's state it sees is that old.
+With `~overload_actions` set (e.g. `[stop]`), the monitor runs those actions as soon as a
+message is dropped or data is read `LATE` or later, and releases them once neither has happened
 for `calm` seconds (a latched action stays until `~reset`). Checked on every engine tick.
 """
 from __future__ import annotations
@@ -10,6 +12,8 @@ from __future__ import annotations
 from typing import Any, Callable, Dict, Optional, Sequence
 
 from .failsafe import FailSafe, Log, Report
+
+LATE = 0.5  # s: data that waited this long in a socket's buffer before the monitor read it: it cannot keep up
 
 
 class OverloadGuard(FailSafe):
@@ -21,35 +25,41 @@ class OverloadGuard(FailSafe):
         super().__init__(actions, log, report)
         self.calm = calm
         self._seen = 0  # drops already accounted for
-        self._last_drop = 0.0
+        self._last_drop = 0.0  # the latest drop or late read
+        self.reason = "dropping messages"  # what started the actions, for the status
 
     def released_text(self, why: str) -> str:
         return f"overload over ({why}): releasing {', '.join(self.actions)}"
 
     def check(self, dropped: int, now: float, runners: Dict[str, Any], latched: Callable[[str], bool],
-              by_topic: Optional[Dict[str, int]] = None) -> None:
-        """On the engine's thread, at each tick: start on new drops, hold, release when calm.
-        by_topic: messages dropped so far per topic, named in the log."""
-        if dropped > self._seen:
+              by_topic: Optional[Dict[str, int]] = None, behind: float = 0.0) -> None:
+        """On the engine's thread, at each tick: start on new drops or late reads, hold, release when
+        calm. by_topic: messages dropped so far per topic, named in the log; behind: the longest any
+        data read since the last tick had waited in its socket's buffer (s)."""
+        late = behind >= LATE
+        if dropped > self._seen or late:
             new, self._seen, self._last_drop = dropped - self._seen, dropped, now
-            what = _topics(by_topic)
             if not self.active and self.actions:
                 self.active = True
-                self.log("error", f"overloaded: {new} messages dropped (the engine's queue is full{what}; the newest "
-                                  f"message of each topic is kept and evaluated): running the fail-safe actions "
-                                  f"{', '.join(self.actions)} (~overload_actions)")
+                self.reason = "dropping messages" if new else f"reading its topics {behind:.2f} s late"
+                why = (f"{new} messages dropped (the engine's queue is full{_topics(by_topic)}; the newest message "
+                       f"of each topic is kept and evaluated)" if new else
+                       f"its topics are read {behind:.2f} s late (their messages wait in the sockets' buffers: it "
+                       f"cannot keep up; a late message is evaluated as if it came now)")
+                self.log("error", f"overloaded: {why}: running the fail-safe actions {', '.join(self.actions)} "
+                                  f"(~overload_actions)")
                 self._send("start", now, runners)
                 return
         if not self.active:
             return
         if now - self._last_drop >= self.calm and not any(latched(a) for a in self.actions):
-            self.release(now, runners, f"no message dropped for {self.calm:g} s")
+            self.release(now, runners, f"no message dropped or read {LATE:g} s late for {self.calm:g} s")
         else:
             self._send("hold", now, runners)
 
-    def would_start(self, dropped: int) -> bool:
-        """Whether check() with this drop count starts the fail-safe actions."""
-        return dropped > self._seen and not self.active and bool(self.actions)
+    def would_start(self, dropped: int, behind: float = 0.0) -> bool:
+        """Whether check() with this drop count and lateness starts the fail-safe actions."""
+        return (dropped > self._seen or behind >= LATE) and not self.active and bool(self.actions)
 
     def reset(self, now: float, runners: Dict[str, Any]) -> bool:
         """~reset: release latched fail-safe actions once calm; whether it did."""

@@ -143,7 +143,11 @@ def build(spec: CheckedSpec, rules: Dict[str, Any], active: List[int], topics: D
     msg = f"enforcing {spec.path}: {counted(len(spec.rules), 'rule')}, {counted(len(spec.behaviours), 'behaviour')}"
     if monitor.get("overloaded", "no") != "no":
         level = ERROR
-        msg += f" (OVERLOADED, dropping messages: {monitor['overloaded']})"
+        cause = monitor.get("overload cause", "none")
+        msg += f" (OVERLOADED, {cause if cause != 'none' else 'dropping messages'}: {monitor['overloaded']})"
+    if monitor.get("read late", "no") != "no":  # the rules see the robot that late (overload, without drops)
+        level = max(level, WARN)
+        msg += f" (READ LATE: {monitor['read late']})"
     if str(monitor.get("master", "connected")) != "connected":
         level = max(level, WARN)
         msg += f" (master {monitor['master']})"

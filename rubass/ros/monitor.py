@@ -68,7 +68,7 @@ from .libtypes import after_check, render_failed_check
 from .livecheck import LiveTypeCheck
 from .nodes import NodeSampler
 from .outputs import Outputs
-from ..actions.overload import OverloadGuard
+from ..actions.overload import LATE, OverloadGuard
 from .clockjump import ClockJump
 from ..actions.errorguard import ErrorGuard
 from ..actions.keeper import LatchKeeper
@@ -383,10 +383,15 @@ class Monitor(Reloading):
         loop = self.loop
         assert loop is not None
         was = self.overload.active
-        if not was and self.overload.would_start(loop.dropped):  # written before the fail-safe runs
+        reader = self.watcher.receiver
+        behind = reader.take_behind() if reader is not None else 0.0  # how late the receiver reads
+        if behind >= LATE and not self.overload.actions:  # with them, the fail-safe's start says it
+            rospy.logwarn_throttle(10, f"rubass: the topics are read {behind:.2f} s late (their messages wait in the "
+                                       f"sockets' buffers: the monitor cannot keep up); no ~overload_actions are set")
+        if not was and self.overload.would_start(loop.dropped, behind):  # written before the fail-safe runs
             self.keeper.save(loop.engine, self.dispatcher.orphans, self._fail_safes(starting=True))
         self.overload.check(loop.dropped, now, self.dispatcher.runners, lambda name: loop.engine.spec.actions[name].latch,
-                            loop.dropped_by_topic)
+                            loop.dropped_by_topic, behind)
         if was and not self.overload.active:
             self.keeper.save(loop.engine, self.dispatcher.orphans, self._fail_safes())
         self.clock_jump.check(loop.engine, now)
@@ -520,11 +525,13 @@ class Monitor(Reloading):
             "coalesced reload requests": self.coalesced,
             "last reload error": self.last_reload_error, "dropped messages": loop.dropped,
             "overloaded": "running " + ", ".join(self.overload.actions) if self.overload.active else "no",
+            "overload cause": self.overload.reason if self.overload.active else "none",
             "failed action attempts": failures,  # every one ever, for the record (no action name has a space)
             "master": self.master_watch.state, "master re-registrations": self.master_watch.reregistrations,
             "reaction latency p50 ms": f"{lat[len(lat) // 2] * 1000:.3f}" if lat else "n/a",
             "nice": self._nice(),
             "receiving": self.watcher.receiving(self.config.receiver),
+            "read late": self.watcher.read_late(),
             "agents": self.agents.summary(time.monotonic()),
             "silent agents": ", ".join(self.agents.silent(time.monotonic())) or "none",
             "agents claiming one host": "; ".join(self.agents.conflicts(time.monotonic())) or "none",

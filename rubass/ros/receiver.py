@@ -36,14 +36,28 @@ OnFrame = Callable[[bytes, Dict[str, str], Any], None]  # (serialised message, c
 
 _SIZE = struct.Struct("<I")
 _RECV = 1 << 16  # bytes per read (rospy's buff_size): a larger message is gathered over several reads
+MAX_MESSAGE = 1 << 30  # bytes: a length prefix beyond it is a broken stream (TCPROS allows 4 GiB), not a message
+# the kernel stamps each packet as it arrives, and a read gets the stamp of the last packet it took: a
+# read of one byte, the stamp of the oldest data waiting. From it to the end of the evaluation of what
+# was read is how late the monitor sees the robot (Linux's value on x86 and ARM; Python's socket
+# module does not name it). Each connection is stamped that way every PROBE seconds (one more read)
+_SO_TIMESTAMPNS = getattr(socket, "SO_TIMESTAMPNS", 35)
+PROBE = 0.1  # s
+_STAMP = struct.Struct("qq")
+_ANC = socket.CMSG_SPACE(_STAMP.size)
 _ROSPY_CONNECT = _pubsub.robust_connect_subscriber
 _EXPECTED = ["conn", "dest_addr", "dest_port", "pub_uri", "receive_cb", "resolved_topic_name"]
+
+
+class _Failed(Exception):
+    """The receiver cannot go on (its text says why): every connection goes back to rospy's threads."""
 
 
 class _Link:
     """One publisher's connection to a watched topic, as the receiver reads it."""
 
-    __slots__ = ("conn", "sock", "fd", "impl", "topic", "header", "latched", "rest", "need")
+    __slots__ = ("conn", "sock", "fd", "impl", "topic", "header", "latched", "rest", "need", "stamped", "stamp",
+                 "probe_at")
 
     def __init__(self, conn: Any, impl: Any, topic: str, rest: bytes) -> None:
         self.conn, self.sock, self.impl, self.topic = conn, conn.socket, impl, topic
@@ -52,6 +66,9 @@ class _Link:
         self.latched = bool(conn.is_latched)
         self.rest = bytearray(rest)  # bytes of a message not complete yet
         self.need = 4  # how many bytes `rest` must hold before it is worth cutting again
+        self.stamped = False  # the kernel stamps its packets (how long they waited is known)
+        self.stamp = 0.0  # the arrival of the oldest data of this read (monotonic clock), 0 if not stamped
+        self.probe_at = 0.0  # when to stamp a read again (monotonic clock)
 
 
 class Receiver:
@@ -74,6 +91,7 @@ class Receiver:
         self._closed = False
         self.given_back = 0  # connections handed to rospy's threads
         self.failed = ""  # why the receiver gave every connection back, if it did
+        self._behind = [0.0, 0.0]  # the latest evaluation after its data arrived, since `take_behind(0)`, `(1)`
         self._thread = threading.Thread(target=self._run, name="rubass-receive", daemon=True)
         self._thread.start()
 
@@ -93,12 +111,19 @@ class Receiver:
     def takes(self, topic: str) -> bool:
         """Whether a new connection of `topic` is the receiver's to read (each batch of its messages
         is checked again: another callback on the topic gives the connection back to rospy)."""
-        return not self._closed and topic in self._routes
+        return not self._closed and topic in self._routes and self._thread.is_alive()
+
+    def take_behind(self, who: int = 0) -> float:
+        """How late the monitor saw its messages (s: from their bytes' arrival in the kernel to the end
+        of their evaluation), the most since this was last asked by `who` (0: the engine's tick, for
+        the overload fail-safe; 1: the status)."""
+        behind, self._behind[who] = self._behind[who], 0.0
+        return behind
 
     def _sole(self, topic: str, impl: Any) -> Optional[Tuple[OnFrame, Any]]:
         """(on_frame, state) when the monitor's callback is the only one `impl` runs, else None."""
         route = self._routes.get(topic)
-        callbacks = impl.callbacks
+        callbacks = impl.callbacks or ()
         if (route is None or len(callbacks) != 1 or callbacks[0][0] != route[0] or callbacks[0][1] is not route[2]
                 or getattr(impl, "statistics_logger", None) is not None):
             return None
@@ -108,13 +133,13 @@ class Receiver:
         """For /diagnostics: who reads the watched topics' connections."""
         if self.failed:
             return f"rospy's threads (the receiver failed: {self.failed})"
-        if not self._thread.is_alive():
-            return "rospy's threads (the receiver stopped)"
         given = f", {self.given_back} given to rospy's threads" if self.given_back else ""
         return f"one thread, {len(self._links)} connection{'s' if len(self._links) != 1 else ''}{given}"
 
     def close(self) -> None:
-        self._closed = True
+        """Stop the thread; the connections it read go back to rospy's threads."""
+        with self._lock:
+            self._closed = True
         self._wake()
         self._thread.join(2.0)
 
@@ -141,6 +166,17 @@ class Receiver:
 
     # -- the thread ------------------------------------------------------------------------------
     def _run(self) -> None:
+        try:
+            self._serve()
+        except _Failed as exc:
+            self._fail(str(exc))
+            return
+        except BaseException as exc:  # noqa: BLE001 - a bug, out of threads, out of memory: never a topic left unread
+            self._fail(f"{exc.__class__.__name__}: {exc}")
+            return
+        self._fail("")  # closed: what it read goes back to rospy's threads
+
+    def _serve(self) -> None:
         swept, failures = time.monotonic(), 0
         while not self._closed:
             try:
@@ -148,8 +184,7 @@ class Receiver:
             except Exception as exc:  # noqa: BLE001 - epoll itself: retried, then rospy's threads take over
                 failures += 1
                 if failures >= self.FAILURES:
-                    self._fail(f"waiting on the sockets: {exc.__class__.__name__}: {exc}")
-                    return
+                    raise _Failed(f"waiting on the sockets: {exc.__class__.__name__}: {exc}") from None
                 time.sleep(0.01)
                 continue
             failures = 0
@@ -161,24 +196,27 @@ class Receiver:
                     elif self._links.get(link.fd) is link:
                         self._read(link)
                 except Exception as exc:  # noqa: BLE001 - that connection goes back to rospy, the rest read on
-                    self.log("error", f"receiver: topic {getattr(link, 'topic', '?')}: {exc.__class__.__name__}: "
-                                      f"{exc}; its connection is read by a rospy thread from now on")
                     if link is not None:
-                        self._give_back(link, [])
+                        self._trouble(link, f"{exc.__class__.__name__}: {exc}")
             now = time.monotonic()
             if now - swept >= self.WAIT:
                 swept = now
                 self._sweep()
-        for link in list(self._links.values()):
-            self._forget(link)
+
+    def _trouble(self, link: _Link, why: str) -> None:
+        """Something unexpected on one connection: logged, and a rospy thread reads it from now on."""
+        self.log("error", f"receiver: topic {link.topic}: {why}; its connection is read by a rospy thread from now on")
+        self._give_back(link, [])
 
     def _fail(self, why: str) -> None:
-        """Every connection back to rospy's threads, for good (logged)."""
-        self.failed = why
-        self.log("error", f"receiver: {why}: every watched topic is read by rospy's threads from now on")
+        """Every connection back to rospy's threads, for good (logged unless the receiver was closed)."""
         with self._lock:
+            closing = self._closed
             self._closed = True  # `takes` says no: new connections are rospy's
             new, self._new = self._new, []
+        if why or not closing:
+            self.failed = why or "stopped"
+            self.log("error", f"receiver: {self.failed}: every watched topic is read by rospy's threads from now on")
         for link in list(self._links.values()) + new:
             try:
                 self._give_back(link, [])
@@ -193,13 +231,16 @@ class Receiver:
             pass  # drained
         with self._lock:
             new, self._new = self._new, []
-        for link in new:
+        for i, link in enumerate(new):
             try:
                 self._add(link)
             except Exception as exc:  # noqa: BLE001 - never a connection left unread: rospy reads it
-                self.log("error", f"receiver: topic {link.topic}: {exc.__class__.__name__}: {exc}; its connection "
-                                  f"is read by a rospy thread")
-                self._give_back(link, [])
+                try:
+                    self._trouble(link, f"{exc.__class__.__name__}: {exc}")
+                except BaseException:
+                    with self._lock:  # the ones after it are still taken (by `_fail` if this thread ends)
+                        self._new[:0] = new[i + 1:]
+                    raise
 
     def _add(self, link: _Link) -> None:
         old = self._links.get(link.fd)
@@ -207,6 +248,11 @@ class Receiver:
             self._forget(old)
         if link.conn.done:
             return
+        try:
+            link.sock.setsockopt(socket.SOL_SOCKET, _SO_TIMESTAMPNS, 1)
+            link.stamped = link.sock.family in (socket.AF_INET, socket.AF_INET6)
+        except OSError:
+            link.stamped = False  # how long its data waited is not known: no lateness measured on it
         self._sel.register(link.fd, selectors.EVENT_READ, link)
         self._links[link.fd] = link
         if len(link.rest) >= 4:  # a message came with the handshake: no read may follow soon
@@ -227,8 +273,12 @@ class Receiver:
                 pass  # closed by rospy: epoll dropped it already
 
     def _read(self, link: _Link) -> None:
+        link.stamp = 0.0
         try:
-            data = link.sock.recv(_RECV)
+            if link.stamped and time.monotonic() >= link.probe_at:
+                data = self._stamped_read(link)
+            else:
+                data = link.sock.recv(_RECV)
         except (BlockingIOError, InterruptedError):
             return
         except OSError:
@@ -240,6 +290,25 @@ class Receiver:
             return
         link.conn.stat_bytes += len(data)
         self._cut(link, data)
+
+    @staticmethod
+    def _stamped_read(link: _Link) -> bytes:
+        """One byte with the stamp of the oldest data waiting (`link.stamp`), then the rest."""
+        head, stamps, _, _ = link.sock.recvmsg(1, _ANC)
+        now = time.monotonic()
+        link.probe_at = now + PROBE
+        for _, kind, raw in stamps:
+            if kind == _SO_TIMESTAMPNS and len(raw) >= _STAMP.size:
+                sec, nsec = _STAMP.unpack_from(raw)
+                # how long it waited, on the kernel's wall clock, then counted on the monotonic one
+                # (a step of the wall clock after it does not read as lateness)
+                link.stamp = now - max(0.0, time.time() - sec - nsec * 1e-9)
+        if not head:
+            return head  # the publisher closed it
+        try:
+            return head + link.sock.recv(_RECV)
+        except (BlockingIOError, InterruptedError):
+            return head  # that byte was all there was
 
     def _cut(self, link: _Link, data: bytes) -> None:
         """Cut the stream into messages and deliver them."""
@@ -259,13 +328,24 @@ class Receiver:
             frames.append(data[off + 4:end])
             off = end
         if off < n:
-            rest += data[off:]
             link.need = 4 + _SIZE.unpack_from(data, off)[0] if n - off >= 4 else 4
+            if link.need > MAX_MESSAGE:  # garbage, not a message: gathering it would exhaust the memory
+                self.log("error", f"receiver: topic {link.topic}: a message of {link.need - 4} bytes announced by "
+                                  f"{link.header.get('callerid', '?')} (over {MAX_MESSAGE >> 20} MiB: a broken stream): "
+                                  f"its connection is closed")
+                self._forget(link)
+                link.conn.close()
+                return
+            rest += data[off:]
         if frames:
             link.conn.stat_num_msg += len(frames)
             self._deliver(link, frames)
 
     def _deliver(self, link: _Link, frames: List[bytes]) -> None:
+        if link.latched:  # rospy's #1852, before any callback runs: a callback added later gets it
+            link.conn.latch = _message(link, frames[-1])
+        if not link.impl.callbacks:  # none yet (the subscriber is being made) or none any more: as rospy,
+            return  # delivered to nobody (a latched message reaches a later callback through the latch)
         sole = self._sole(link.topic, link.impl)
         if sole is None:  # another callback on the topic now (or a reload dropped it): rospy's delivery
             self._give_back(link, frames)
@@ -277,8 +357,12 @@ class Receiver:
                 on_frame(frame, header, state)
             except Exception as exc:  # noqa: BLE001 - as rospy's `bad callback`: the next message is delivered
                 self.log("error", f"topic {link.topic}: {exc.__class__.__name__}: {exc}")
-        if link.latched:  # rospy's #1852: a callback added later gets the latched message
-            link.conn.latch = _message(link, frames[-1])
+        if link.stamp:  # the last of them was evaluated this long after its bytes arrived
+            behind = time.monotonic() - link.stamp
+            if behind > self._behind[0]:
+                self._behind[0] = behind
+            if behind > self._behind[1]:
+                self._behind[1] = behind
 
     def _give_back(self, link: _Link, frames: List[bytes]) -> None:
         """A rospy thread reads this connection from now on, these messages first."""

@@ -2,6 +2,7 @@
 every watched topic, through publishers that come and go, latched and large messages, a `limit`
 action reading a topic the spec reads too, and `~receiver: rospy` for rospy's own threads."""
 import json
+import os
 import subprocess
 import time
 
@@ -112,3 +113,29 @@ def test_receiver_rospy_keeps_rospys_threads_and_a_bad_value_is_refused(ros, tmp
     assert ("~receiver must be one_thread (one thread reads every watched topic) or rospy (a rospy thread per "
             "connection, as rospy subscribers do), got 'threads'") in log, log
     assert "Traceback" not in log
+
+
+def test_a_monitor_that_read_its_topics_a_second_late_runs_the_overload_fail_safe(ros, tmp_path):
+    """The monitor stalled for 1 s (SIGSTOP: the computer overloaded, swapping): nothing is dropped,
+    the messages wait in the sockets' buffers, and the rules then see the robot a second late.
+    rospy's threads would say nothing; the receiver's arrival stamps start ~overload_actions."""
+    import signal
+
+    mon = ros.monitor(spec(tmp_path, FAST), overload_actions="[brake]")
+    probe = ros.probe_bg({"listen": [{"topic": "/brake", "type": "std_msgs/Bool"}],
+                          "advertise": [{"topic": "/cmd_vel", "type": TWIST}],
+                          "steps": [{"wait_subscribers": "/cmd_vel"}, {"wait_publishers": "/brake"}, {"sleep": 0.3},
+                                    {"mark": "go"},
+                                    {"publish": "/cmd_vel", "msg": {"linear": {"x": 0.0}}, "repeat": 200,
+                                     "period": 0.02}, {"sleep": 0.5}], "linger": 0.1}, name="driver")
+    time.sleep(3.0)  # the driver publishes from ~1 s on; the monitor is stopped in the middle of it
+    os.kill(mon.pid, signal.SIGSTOP)
+    time.sleep(1.0)
+    os.kill(mon.pid, signal.SIGCONT)
+    out, _ = probe.communicate(timeout=30)
+    rec = [json.loads(x) for x in out.splitlines() if x.startswith("{")]
+    brakes = [r for r in rec if r["kind"] == "recv" and r["topic"] == "/brake" and r["msg"]["data"] is True]
+    log = ros.log(mon)
+    assert brakes, log  # no rule is violated (x = 0): only the fail-safe brakes
+    assert "overloaded: its topics are read" in log and "s late (their messages wait in the sockets' buffers" in log
+    assert "overload over (no message dropped or read 0.5 s late for 1 s): releasing brake" in log, log

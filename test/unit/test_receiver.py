@@ -282,3 +282,114 @@ def test_install_replaces_rospys_connecting_function_once(monkeypatch):
         assert rx.install(lambda level, text: None) is first
     finally:
         first.close()
+
+
+def test_a_latched_message_that_comes_before_the_monitors_callback_reaches_it_through_the_latch(receiver):
+    """rospy registers, connects, then adds the callback: a fast latched publisher can be first."""
+    t = Topic.__new__(Topic)  # the subscriber without its callback yet
+    t.name, t.receiver, t.state = "/t", receiver, object()
+    t.impl = _SubscriberImpl("/t", rospy.AnyMsg)
+    t.got, t.via_rospy, t.seen = [], [], threading.Condition()
+    receiver.route("/t", t.callback, t.on_frame, t.state)
+    conn, pub = t.connect(rest=frame(b"latched"), latched=True)
+    assert until(lambda: conn.latch is not None and conn.latch._buff == b"latched")
+    t.impl.add_callback(t.callback, t.state)  # rospy's add_callback replays the latch
+    pub.sendall(frame(b"next"))
+    assert t.wait(2) == [b"latched", b"next"]
+    assert receiver.given_back == 0 and t.via_rospy == [b"latched"]  # the next one read by the receiver
+
+
+def test_the_latch_is_set_before_the_callback_runs(receiver):
+    """A callback added while the monitor evaluates a latched message must get it (rospy's order)."""
+    t = Topic(receiver)
+    seen_latch = []
+    real = t.on_frame
+
+    def on_frame(buff, header, state):
+        seen_latch.append(conn.latch._buff if conn.latch is not None else None)
+        real(buff, header, state)
+
+    receiver.route("/t", t.callback, on_frame, t.state)
+    conn, pub = t.connect(latched=True)
+    pub.sendall(frame(b"a"))
+    t.wait(1)
+    pub.sendall(frame(b"b"))
+    t.wait(2)
+    assert seen_latch == [b"a", b"b"]
+
+
+def test_a_closed_subscriber_is_no_error_and_no_hand_back(receiver):
+    t = Topic(receiver)
+    conn, pub = t.connect()
+    t.impl.callbacks = None  # rospy's _SubscriberImpl.close()
+    pub.sendall(frame(b"x"))
+    time.sleep(0.3)
+    assert t.got == [] and receiver.given_back == 0 and receiver.logs == []
+
+
+def test_a_length_prefix_beyond_a_gibibyte_closes_that_connection_only(receiver):
+    t, u = Topic(receiver), Topic(receiver, "/u")
+    conn, pub = t.connect()
+    _, other = u.connect()
+    pub.sendall(struct.pack("<I", (1 << 30) + 1) + b"garbage")
+    assert until(lambda: conn.done)
+    assert any("a message of 1073741825 bytes announced by /pub (over 1024 MiB: a broken stream): its connection "
+               "is closed" in text for _, text in receiver.logs), receiver.logs
+    other.sendall(frame(b"fine"))
+    assert u.wait(1) == [b"fine"]
+
+
+def test_if_the_thread_dies_every_connection_goes_back_to_rospy_and_new_ones_are_rospys(receiver, monkeypatch):
+    t = Topic(receiver)
+    conn, pub = t.connect()
+    pub.sendall(frame(b"before"))
+    t.wait(1)
+
+    def dies(link):
+        raise SystemExit("a bug beyond Exception")
+
+    monkeypatch.setattr(receiver, "_read", dies)
+    pub.sendall(frame(b"after"))
+    assert until(lambda: receiver.failed)
+    assert t.wait(2) == [b"before", b"after"] and t.via_rospy == [b"after"]
+    assert not receiver.takes("/t")
+    assert receiver.describe() == "rospy's threads (the receiver failed: SystemExit: a bug beyond Exception)"
+
+
+def tcp_pair():
+    srv = socket.socket()
+    srv.bind(("127.0.0.1", 0))
+    srv.listen(1)
+    client = socket.create_connection(srv.getsockname())
+    server, _ = srv.accept()
+    srv.close()
+    return client, server
+
+
+def test_how_late_the_data_was_read_is_measured_on_tcp(receiver):
+    """The kernel's arrival stamp of each read: a receiver that cannot keep up reads its data late."""
+    t = Topic(receiver)
+    real = t.on_frame
+
+    def slow(buff, header, state):
+        time.sleep(0.1)  # 100 ms of evaluation per message
+        real(buff, header, state)
+
+    receiver.route("/t", t.callback, slow, t.state)
+    ours, pub = tcp_pair()
+    conn = TCPROSTransport(TCPROSSub("/t", rospy.AnyMsg), "/t")
+    conn.set_socket(ours, "http://pub:1/")
+    conn.header, conn.is_latched = dict(HEADER), False
+    t.impl.add_connection(conn)
+    assert receiver.hand_over(conn, t.impl, "/t")
+    assert until(lambda: receiver.describe() == "one thread, 1 connection")
+    assert receiver.take_behind() < 0.05 and receiver.take_behind(1) < 0.05
+    for i in range(12):  # 1.2 s of evaluation, sent at once, each read separately
+        pub.sendall(frame(b"m%d" % i))
+        time.sleep(0.002)
+    t.wait(12, timeout=5)
+    behind = receiver.take_behind()
+    assert 0.5 < behind < 1.5, behind  # the last ones waited about a second
+    assert receiver.take_behind() == 0.0  # taken
+    assert 0.5 < receiver.take_behind(1) < 1.5  # the status asks on its own
+    pub.close()

@@ -31,6 +31,16 @@ def test_an_overloaded_monitor_is_error_and_names_the_fail_safe_actions():
     assert e.level == status.ERROR and "OVERLOADED, dropping messages: running stop" in e.message
 
 
+def test_an_overload_by_late_reading_says_so_and_late_reading_alone_is_a_warning():
+    e = monitor_entry(master="connected", overloaded="running stop",
+                      **{"overload cause": "reading its topics 0.84 s late"})
+    assert e.level == status.ERROR and "OVERLOADED, reading its topics 0.84 s late: running stop" in e.message
+    late = "0.84 s (messages waited that long in the sockets' buffers: the monitor cannot keep up)"
+    e = monitor_entry(master="connected", **{"read late": late})
+    assert e.level == status.WARN and f"(READ LATE: {late})" in e.message
+    assert monitor_entry(master="connected", **{"read late": "no"}).level == status.OK
+
+
 def test_an_action_failure_is_error_only_until_a_later_attempt_succeeds():
     """A stop that reached no subscriber once, then did: the count stays on record, the level is OK."""
     from rubass.actions.base import ActionStats
