@@ -43,6 +43,7 @@ MAX_MESSAGE = 1 << 30  # bytes: a length prefix beyond it is a broken stream (TC
 # module does not name it). Each connection is stamped that way every PROBE seconds (one more read)
 _SO_TIMESTAMPNS = getattr(socket, "SO_TIMESTAMPNS", 35)
 PROBE = 0.1  # s
+_STEP = 0.01  # s: the wall clock moved this much against the monotonic one: stepped (NTP), its stamps not used
 _STAMP = struct.Struct("qq")
 _ANC = socket.CMSG_SPACE(_STAMP.size)
 _ROSPY_CONNECT = _pubsub.robust_connect_subscriber
@@ -57,7 +58,7 @@ class _Link:
     """One publisher's connection to a watched topic, as the receiver reads it."""
 
     __slots__ = ("conn", "sock", "fd", "impl", "topic", "header", "latched", "rest", "need", "stamped", "stamp",
-                 "probe_at")
+                 "probe_at", "offset")
 
     def __init__(self, conn: Any, impl: Any, topic: str, rest: bytes) -> None:
         self.conn, self.sock, self.impl, self.topic = conn, conn.socket, impl, topic
@@ -69,6 +70,7 @@ class _Link:
         self.stamped = False  # the kernel stamps its packets (how long they waited is known)
         self.stamp = 0.0  # the arrival of the oldest data of this read (monotonic clock), 0 if not stamped
         self.probe_at = 0.0  # when to stamp a read again (monotonic clock)
+        self.offset = time.time() - time.monotonic()  # the wall clock's, at the latest stamped read
 
 
 class Receiver:
@@ -92,6 +94,7 @@ class Receiver:
         self.given_back = 0  # connections handed to rospy's threads
         self.failed = ""  # why the receiver gave every connection back, if it did
         self._behind = [0.0, 0.0]  # the latest evaluation after its data arrived, since `take_behind(0)`, `(1)`
+        self._busy_since = 0.0  # when the wait on the sockets last returned, while what it returned is handled
         self._thread = threading.Thread(target=self._run, name="rubass-receive", daemon=True)
         self._thread.start()
 
@@ -118,7 +121,9 @@ class Receiver:
         of their evaluation), the most since this was last asked by `who` (0: the engine's tick, for
         the overload fail-safe; 1: the status)."""
         behind, self._behind[who] = self._behind[who], 0.0
-        return behind
+        busy = self._busy_since
+        # still busy with what one wait returned: whatever came meanwhile waits at least that long
+        return max(behind, time.monotonic() - busy) if busy else behind
 
     def _sole(self, topic: str, impl: Any) -> Optional[Tuple[OnFrame, Any]]:
         """(on_frame, state) when the monitor's callback is the only one `impl` runs, else None."""
@@ -188,6 +193,7 @@ class Receiver:
                 time.sleep(0.01)
                 continue
             failures = 0
+            self._busy_since = time.monotonic() if events else 0.0
             for key, _ in events:
                 link = key.data
                 try:
@@ -198,7 +204,12 @@ class Receiver:
                 except Exception as exc:  # noqa: BLE001 - that connection goes back to rospy, the rest read on
                     if link is not None:
                         self._trouble(link, f"{exc.__class__.__name__}: {exc}")
+                    else:
+                        self.log("error", f"receiver: taking new connections: {exc.__class__.__name__}: {exc}")
             now = time.monotonic()
+            if self._busy_since:
+                self._late(now - self._busy_since)  # a long turn: what came during it waited that long
+                self._busy_since = 0.0
             if now - swept >= self.WAIT:
                 swept = now
                 self._sweep()
@@ -240,6 +251,7 @@ class Receiver:
                 except BaseException:
                     with self._lock:  # the ones after it are still taken (by `_fail` if this thread ends)
                         self._new[:0] = new[i + 1:]
+                    self._wake()
                     raise
 
     def _add(self, link: _Link) -> None:
@@ -295,20 +307,22 @@ class Receiver:
     def _stamped_read(link: _Link) -> bytes:
         """One byte with the stamp of the oldest data waiting (`link.stamp`), then the rest."""
         head, stamps, _, _ = link.sock.recvmsg(1, _ANC)
-        now = time.monotonic()
+        now, wall = time.monotonic(), time.time()
         link.probe_at = now + PROBE
+        offset, link.offset = link.offset, wall - now
         for _, kind, raw in stamps:
-            if kind == _SO_TIMESTAMPNS and len(raw) >= _STAMP.size:
+            if kind == _SO_TIMESTAMPNS and len(raw) >= _STAMP.size and abs(wall - now - offset) < _STEP:
                 sec, nsec = _STAMP.unpack_from(raw)
-                # how long it waited, on the kernel's wall clock, then counted on the monotonic one
-                # (a step of the wall clock after it does not read as lateness)
-                link.stamp = now - max(0.0, time.time() - sec - nsec * 1e-9)
+                # how long it waited, on the kernel's wall clock (not across a step of it: the
+                # wall clock kept its pace against the monotonic one since the last stamped read),
+                # then counted on the monotonic one
+                link.stamp = now - max(0.0, wall - sec - nsec * 1e-9)
         if not head:
             return head  # the publisher closed it
         try:
             return head + link.sock.recv(_RECV)
-        except (BlockingIOError, InterruptedError):
-            return head  # that byte was all there was
+        except OSError:
+            return head  # that byte was all there was (an error comes back at the next read)
 
     def _cut(self, link: _Link, data: bytes) -> None:
         """Cut the stream into messages and deliver them."""
@@ -357,12 +371,15 @@ class Receiver:
                 on_frame(frame, header, state)
             except Exception as exc:  # noqa: BLE001 - as rospy's `bad callback`: the next message is delivered
                 self.log("error", f"topic {link.topic}: {exc.__class__.__name__}: {exc}")
-        if link.stamp:  # the last of them was evaluated this long after its bytes arrived
-            behind = time.monotonic() - link.stamp
-            if behind > self._behind[0]:
-                self._behind[0] = behind
-            if behind > self._behind[1]:
-                self._behind[1] = behind
+            if link.stamp:  # the oldest data of a stamped read, evaluated this long after it arrived
+                self._late(time.monotonic() - link.stamp)
+                link.stamp = 0.0
+
+    def _late(self, behind: float) -> None:
+        if behind > self._behind[0]:
+            self._behind[0] = behind
+        if behind > self._behind[1]:
+            self._behind[1] = behind
 
     def _give_back(self, link: _Link, frames: List[bytes]) -> None:
         """A rospy thread reads this connection from now on, these messages first."""
