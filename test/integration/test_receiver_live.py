@@ -141,3 +141,25 @@ def test_a_monitor_that_read_its_topics_a_second_late_runs_the_overload_fail_saf
     assert brakes, log  # no rule is violated (x = 0): only the fail-safe brakes
     assert "overloaded: its topics are read" in log and "s late (their messages wait in the sockets' buffers" in log
     assert "overload over (no message dropped or read 0.5 s late for 1 s): releasing brake" in log, log
+
+
+def test_without_overload_actions_late_reading_is_a_warning_in_the_log_and_diagnostics(ros, tmp_path):
+    import signal
+
+    mon = ros.monitor(spec(tmp_path, FAST))
+    driver = ros.probe_bg({"advertise": [{"topic": "/cmd_vel", "type": TWIST}],
+                           "steps": [{"wait_subscribers": "/cmd_vel"},
+                                     {"publish": "/cmd_vel", "msg": {"linear": {"x": 0.0}}, "repeat": 400,
+                                      "period": 0.02}]}, name="driver")
+    time.sleep(2.5)
+    os.kill(mon.pid, signal.SIGSTOP)
+    time.sleep(2.0)
+    os.kill(mon.pid, signal.SIGCONT)
+    rec = ros.probe({"listen": [{"topic": "/diagnostics", "type": "diagnostic_msgs/DiagnosticArray"}],
+                     "steps": [{"wait": "/diagnostics", "timeout": 10}, {"sleep": 0.5}]})
+    driver.communicate(timeout=30)
+    mons = [s for r in rec if r["kind"] == "recv" for s in r["msg"]["status"] if s["name"] == "rubass: monitor"]
+    late = [s for s in mons if dict((kv["key"], kv["value"]) for kv in s["values"])["read late"] != "no"]
+    assert late and late[0]["level"] == 1 and "(READ LATE: " in late[0]["message"], (mons, ros.log(mon))
+    assert "s late (their messages wait in the sockets' buffers: the monitor cannot keep up); no ~overload_actions " \
+           "are set" in ros.log(mon), ros.log(mon)
