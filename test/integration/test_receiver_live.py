@@ -147,16 +147,22 @@ def test_without_overload_actions_late_reading_is_a_warning_in_the_log_and_diagn
     import signal
 
     mon = ros.monitor(spec(tmp_path, FAST))
+    # the status right after the stall says it: listening from before it (a CI run's listener,
+    # started after, came too late for it)
+    diag = ros.probe_bg({"listen": [{"topic": "/diagnostics", "type": "diagnostic_msgs/DiagnosticArray"}],
+                         "steps": [{"wait_publishers": "/diagnostics"}, {"mark": "ready"}, {"sleep": 9.0}]},
+                        name="diag")
+    assert '"ready"' in diag.stdout.readline()
     driver = ros.probe_bg({"advertise": [{"topic": "/cmd_vel", "type": TWIST}],
                            "steps": [{"wait_subscribers": "/cmd_vel"},
-                                     {"publish": "/cmd_vel", "msg": {"linear": {"x": 0.0}}, "repeat": 400,
+                                     {"publish": "/cmd_vel", "msg": {"linear": {"x": 0.0}}, "repeat": 300,
                                       "period": 0.02}]}, name="driver")
     time.sleep(2.5)
     os.kill(mon.pid, signal.SIGSTOP)
     time.sleep(2.0)
     os.kill(mon.pid, signal.SIGCONT)
-    rec = ros.probe({"listen": [{"topic": "/diagnostics", "type": "diagnostic_msgs/DiagnosticArray"}],
-                     "steps": [{"wait": "/diagnostics", "timeout": 10}, {"sleep": 0.5}]})
+    out, _ = diag.communicate(timeout=30)
+    rec = [json.loads(x) for x in out.splitlines() if x.startswith("{")]
     driver.communicate(timeout=30)
     mons = [s for r in rec if r["kind"] == "recv" for s in r["msg"]["status"] if s["name"] == "rubass: monitor"]
     late = [s for s in mons if dict((kv["key"], kv["value"]) for kv in s["values"])["read late"] != "no"]

@@ -369,8 +369,11 @@ def tcp_pair():
 def tcp_link(receiver, t):
     """A TCP connection (the kernel stamps TCP packets, not a socket pair's) to topic `t`, not handed over yet."""
     ours, pub = tcp_pair()
-    # stamped from the start (the kernel stamps a packet only while some socket asks for stamps)
+    # stamped from the start: the kernel stamps a packet only while some socket asks for stamps, and
+    # turns stamping on a moment after the first asks (deferred work), so a packet sent at once after
+    # it may go unstamped (read as "now": a CI run met it)
     ours.setsockopt(socket.SOL_SOCKET, rx._SO_TIMESTAMPNS, 1)
+    time.sleep(0.2)
     conn = TCPROSTransport(TCPROSSub(t.name, rospy.AnyMsg), t.name)
     conn.set_socket(ours, "http://pub:1/")
     conn.header, conn.is_latched = dict(HEADER), False
