@@ -34,8 +34,8 @@ class OverloadGuard(FailSafe):
     def check(self, dropped: int, now: float, runners: Dict[str, Any], latched: Callable[[str], bool],
               by_topic: Optional[Dict[str, int]] = None, behind: float = 0.0) -> None:
         """On the engine's thread, at each tick: start on new drops or late reads, hold, release when
-        calm. by_topic: messages dropped so far per topic, named in the log; behind: the longest any
-        data read since the last tick had waited in its socket's buffer (s)."""
+        calm. by_topic: messages dropped so far per topic, named in the log; behind: how late the
+        receiver saw its messages since the last tick (s; Receiver.take_behind)."""
         late = behind >= LATE
         if dropped > self._seen or late:
             new, self._seen, self._last_drop = dropped - self._seen, dropped, now

@@ -220,14 +220,13 @@ class Receiver:
         self._give_back(link, [])
 
     def _fail(self, why: str) -> None:
-        """Every connection back to rospy's threads, for good (logged unless the receiver was closed)."""
+        """Every connection back to rospy's threads, for good (`why`: logged; empty when closed)."""
         with self._lock:
-            closing = self._closed
             self._closed = True  # `takes` says no: new connections are rospy's
             new, self._new = self._new, []
-        if why or not closing:
-            self.failed = why or "stopped"
-            self.log("error", f"receiver: {self.failed}: every watched topic is read by rospy's threads from now on")
+        if why:
+            self.failed = why
+            self.log("error", f"receiver: {why}: every watched topic is read by rospy's threads from now on")
         for link in list(self._links.values()) + new:
             try:
                 self._give_back(link, [])

@@ -53,6 +53,16 @@ class Topic:
             self.got.append(bytes(buff))
             self.seen.notify_all()
 
+    def slowed(self, seconds):
+        """Each message of this topic evaluated `seconds` long from now on (a slow evaluation)."""
+        real = self.on_frame
+
+        def slow(buff, header, state):
+            time.sleep(seconds)
+            real(buff, header, state)
+
+        self.receiver.route(self.name, self.callback, slow, self.state)
+
     def wait(self, n, timeout=5.0):
         with self.seen:
             assert self.seen.wait_for(lambda: len(self.got) >= n, timeout), self.got
@@ -403,13 +413,7 @@ def test_a_step_of_the_wall_clock_is_not_lateness(receiver, monkeypatch):
     """NTP steps the clock 5 s forward while data waits (the receiver busy 0.3 s with another topic):
     its kernel stamp is 5 s old on the new clock; what is lateness is the 0.3 s turn."""
     u = Topic(receiver, "/u")
-    real_frame = u.on_frame
-
-    def slow(buff, header, state):
-        time.sleep(0.3)
-        real_frame(buff, header, state)
-
-    receiver.route("/u", u.callback, slow, u.state)
+    u.slowed(0.3)
     _, upub = u.connect()
     t = Topic(receiver)
     conn, pub = tcp_link(receiver, t)
@@ -429,13 +433,7 @@ def test_a_step_of_the_wall_clock_is_not_lateness(receiver, monkeypatch):
 def test_a_long_turn_of_the_thread_is_lateness_while_it_lasts(receiver):
     """A turn of 1.2 s (evaluation that slow, a starved CPU): the tick asking meanwhile sees it grow."""
     t = Topic(receiver)
-    real = t.on_frame
-
-    def slow(buff, header, state):
-        time.sleep(0.4)
-        real(buff, header, state)
-
-    receiver.route("/t", t.callback, slow, t.state)
+    t.slowed(0.4)
     _, pub = t.connect()
     pub.sendall(frame(b"a") + frame(b"b") + frame(b"c"))
     time.sleep(0.9)
