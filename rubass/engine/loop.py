@@ -10,6 +10,7 @@ import dataclasses
 import math
 import queue
 import threading
+import time
 from dataclasses import dataclass
 from typing import Any, Callable, Dict, List, Optional, Tuple
 
@@ -27,6 +28,7 @@ class Message:
     received: float = 0.0  # wall-clock arrival, to measure reaction latency
     size: int = 0  # serialised bytes, counted against the queue's byte budget
     also: Tuple[str, ...] = ()  # the topic's other spellings in the spec: the same message, one instant
+    arrived: float = 0.0  # monotonic arrival (s): how long it waited in the queue is measured from it (0: not)
 
 
 @dataclass(frozen=True)
@@ -54,6 +56,10 @@ class EngineLoop:
     message: that thread then only wakes for deadlines and ticks, and for what queued up while
     another thread held the engine. Everything the engine does still happens under one lock, in
     the order inputs were queued. `on_error` gets what an input handled inline raised.
+
+    How long a queued message waited before the engine took it (from its `arrived`, on `mono`)
+    is kept for `take_waited`: a monitor whose engine cannot keep up drops nothing until the queue
+    is full (100,000 messages: minutes at some rates), but its rules see the robot that late.
     """
 
     BURST = 256  # inputs one submitting thread handles before it leaves the rest to the engine's thread
@@ -61,7 +67,8 @@ class EngineLoop:
     def __init__(self, engine: Engine, clock: Callable[[], float], rate: float, handler: Handler,
                  max_queue: int = 100000, tick_hook: Optional[Callable[[float], None]] = None,
                  max_bytes: int = 256 * 1024 * 1024, on_clock_jump: Optional[JumpHook] = None,
-                 inline: bool = False, on_error: Optional[Callable[[Exception], None]] = None) -> None:
+                 inline: bool = False, on_error: Optional[Callable[[Exception], None]] = None,
+                 mono: Callable[[], float] = time.monotonic) -> None:
         self.engine = engine
         self.clock = clock
         self.period = 1.0 / rate
@@ -91,6 +98,8 @@ class EngineLoop:
         self._engine_lock = threading.Lock()  # held while anything runs the engine (inline mode)
         self._wake = threading.Event()  # inline mode: an earlier deadline, or inputs left over
         self._sleep_until = math.inf  # when the engine's thread wakes next by itself
+        self.mono = mono
+        self._waited = [0.0, 0.0]  # the longest a message waited in the queue, per asker (take_waited)
 
     # -- any thread ----------------------------------------------------------------------
     def submit(self, item: Any) -> bool:
@@ -145,11 +154,12 @@ class EngineLoop:
         """Inline mode: handle what is queued, if no other thread is handling it already."""
         lock, pending = self._engine_lock, self.inbox.queue
         while pending and lock.acquire(False):
-            handled = 0
+            handed = False
             try:
-                handled = self._drain(self.BURST)
-                if handled >= self.BURST:
-                    self._wake.set()  # the engine's thread goes on
+                handled = self._drain(self.BURST, self._next_tick)
+                handed = handled >= self.BURST or bool(pending) and self.clock() >= self._next_tick
+                if handed:
+                    self._wake.set()  # the engine's thread goes on, after its tick
                 else:
                     self._wake_if_sooner()
             except Exception as exc:
@@ -158,7 +168,7 @@ class EngineLoop:
                 self.on_error(exc)
             finally:
                 lock.release()
-            if handled >= self.BURST:
+            if handed:
                 return
             # an input queued while we held the lock, whose thread could not take it, is ours
 
@@ -190,6 +200,19 @@ class EngineLoop:
             raise value
         return value
 
+    def take_waited(self, who: int = 0) -> float:
+        """The longest a message waited in the queue before the engine took it (s), since `who` last
+        asked (0: the tick's overload check, 1: the status)."""
+        waited, self._waited[who] = self._waited[who], 0.0
+        return waited
+
+    def _note_wait(self, arrived: float) -> None:
+        waited = self.mono() - arrived
+        if waited > self._waited[0]:
+            self._waited[0] = waited
+        if waited > self._waited[1]:
+            self._waited[1] = waited
+
     def stop(self) -> None:
         self._stop.set()
         self._wake.set()
@@ -214,7 +237,7 @@ class EngineLoop:
             self._wake.clear()
             with self._engine_lock:
                 self._sleep_until = -math.inf  # awake: a submitting thread need not wake it
-                self._drain(self.BURST)
+                self._drain(self.BURST, self._next_tick)
                 self._due()
             return
         timeout = self._wait_for(max_wait)
@@ -247,10 +270,14 @@ class EngineLoop:
             timeout = min(timeout, max_wait)
         return timeout
 
-    def _drain(self, limit: Optional[int]) -> int:
-        """Handle up to `limit` queued inputs (all, if None) in queue order, then the conflated newest."""
-        get, handled = self.inbox.get_nowait, 0
+    def _drain(self, limit: Optional[int], until: float = math.inf) -> int:
+        """Handle up to `limit` queued inputs (all, if None) in queue order, then the conflated newest;
+        from the second on, none once the clock reads `until` (the tick: a busy engine still ticks, so
+        its overload check and the rules of time run between messages, not after a whole burst)."""
+        get, handled, clock = self.inbox.get_nowait, 0, self.clock
         while limit is None or handled < limit:
+            if handled and until <= clock():
+                break
             try:
                 item = get()
             except queue.Empty:
@@ -295,6 +322,8 @@ class EngineLoop:
         with self._bytes_lock:
             items, self._newest = sorted(self._newest.values(), key=lambda m: m.time), {}
         for m in items:
+            if m.arrived:
+                self._note_wait(m.arrived)
             self._applied[m.topic] = m.time
             self._emit(self._on_message(m), m)
 
@@ -310,6 +339,8 @@ class EngineLoop:
         if isinstance(item, Message):
             if queued:
                 self._unqueue(item.size)
+                if item.arrived:
+                    self._note_wait(item.arrived)
             if self._applied and item.time <= self._applied.get(item.topic, float("-inf")):
                 return  # older than a newer message of its topic already handled (conflated)
             self._emit(self._on_message(item), item)

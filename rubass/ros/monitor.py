@@ -10,7 +10,7 @@ Parameters (private)
     ~diagnostics_rate (Hz, 1)     /diagnostics publications
     ~master_rate (Hz, default 4)  checks that the master still knows the monitor (re-registers
                                   after a master restart: docs/monitor.md)
-    ~overload_actions (list)      actions to run while the engine's queue drops messages (fail safe)
+    ~overload_actions (list)      actions to run while messages are dropped or seen 0.5 s late (fail safe)
     ~queue_size (10 to 10000000, default 100000)  messages the engine's queue holds (and 256 MiB
                                   of message bytes)
     ~error_actions (list)         actions to run while a field cannot be read as the spec needs (fail safe)
@@ -68,7 +68,7 @@ from .libtypes import after_check, render_failed_check
 from .livecheck import LiveTypeCheck
 from .nodes import NodeSampler
 from .outputs import Outputs
-from ..actions.overload import LATE, OverloadGuard
+from ..actions.overload import LATE, QUEUE, SOCKETS, OverloadGuard, late_status, lateness
 from .clockjump import ClockJump
 from ..actions.errorguard import ErrorGuard
 from ..actions.keeper import LatchKeeper
@@ -81,6 +81,8 @@ from .exiting import EXIT_GRACE, exit_within
 from .reloading import ConfigError, Reloading, StartupError, said_if_slow
 from . import receiver
 from .topics import TopicWatcher, ros_now
+
+_mono = time.monotonic
 
 
 def _log(level: str, text: str) -> None:
@@ -242,6 +244,9 @@ class Monitor(Reloading):
         """An ERROR status saying why the full one is missing (e.g. the engine's thread stalled)."""
         why = "the engine's thread did not answer (stalled?)" if isinstance(exc, (queue.Empty, queue.Full)) \
             else f"{exc.__class__.__name__}: {exc}"
+        if isinstance(exc, (queue.Empty, queue.Full)) and self.overload.active:  # it answers behind the queue
+            why = (f"the engine's thread did not answer: OVERLOADED, {self.overload.reason}: running "
+                   f"{', '.join(self.overload.actions)}")
         try:
             self.outputs.status([status_mod.Entry("rubass: monitor", status_mod.ERROR, f"STATUS UNAVAILABLE: {why}",
                                                   [("spec", self.config.spec)])], _ros_now())
@@ -384,14 +389,17 @@ class Monitor(Reloading):
         assert loop is not None
         was = self.overload.active
         reader = self.watcher.receiver
-        behind = reader.take_behind() if reader is not None else 0.0  # how late the receiver reads
+        read = reader.take_behind() if reader is not None else 0.0  # how late the receiver reads
+        waited = loop.take_waited()  # and how long messages wait in the engine's queue after it
+        behind, where = (waited, QUEUE) if waited > read else (read, SOCKETS)
         if behind >= LATE and not self.overload.actions:  # with them, the fail-safe's start says it
-            rospy.logwarn_throttle(10, f"rubass: the topics are read {behind:.2f} s late (their messages wait in the "
-                                       f"sockets' buffers: the monitor cannot keep up); no ~overload_actions are set")
+            what, waits = lateness(behind, where)
+            rospy.logwarn_throttle(10, f"rubass: {what} ({waits}: the monitor cannot keep up); no ~overload_actions "
+                                       f"are set")
         if not was and self.overload.would_start(loop.dropped, behind):  # written before the fail-safe runs
             self.keeper.save(loop.engine, self.dispatcher.orphans, self._fail_safes(starting=True))
         self.overload.check(loop.dropped, now, self.dispatcher.runners, lambda name: loop.engine.spec.actions[name].latch,
-                            loop.dropped_by_topic, behind)
+                            loop.dropped_by_topic, behind, where)
         if was and not self.overload.active:
             self.keeper.save(loop.engine, self.dispatcher.orphans, self._fail_safes())
         self.clock_jump.check(loop.engine, now)
@@ -418,10 +426,10 @@ class Monitor(Reloading):
         return sampler
 
     def _on_message(self, topic: str, now: float, msg: Any, wall: float, size: int) -> None:
-        self.loop.submit(Message(topic, now, msg, wall, size))
+        self.loop.submit(Message(topic, now, msg, wall, size, (), _mono()))
 
     def _on_spellings(self, topics: Tuple[str, ...], now: float, msg: Any, wall: float, size: int) -> None:
-        self.loop.submit(Message(topics[0], now, msg, wall, size, topics[1:]))
+        self.loop.submit(Message(topics[0], now, msg, wall, size, topics[1:], _mono()))
 
     def _on_agent(self, msg: String) -> None:
         try:
@@ -520,6 +528,7 @@ class Monitor(Reloading):
         nodes = {s.spec_name: {"why": s.why, "resolved": s.resolved} for s in self.sampler.status.values()}
         failures = self.retired_failures + sum(r.stats.failures for r in self.runners.values())
         lat = sorted(self.dispatcher.latencies)
+        reader = self.watcher.receiver
         monitor: Dict[str, Any] = {
             "spec": self.spec.path, "reloads": self.reloads, "rejected reloads": self.rejected,
             "coalesced reload requests": self.coalesced,
@@ -531,7 +540,7 @@ class Monitor(Reloading):
             "reaction latency p50 ms": f"{lat[len(lat) // 2] * 1000:.3f}" if lat else "n/a",
             "nice": self._nice(),
             "receiving": self.watcher.receiving(self.config.receiver),
-            "read late": self.watcher.read_late(),
+            "read late": late_status(reader.take_behind(1) if reader is not None else 0.0, loop.take_waited(1)),
             "agents": self.agents.summary(time.monotonic()),
             "silent agents": ", ".join(self.agents.silent(time.monotonic())) or "none",
             "agents claiming one host": "; ".join(self.agents.conflicts(time.monotonic())) or "none",

@@ -28,7 +28,7 @@ class MonitorConfig:
     node_rate: float = 10.0  # node samples per second
     diagnostics_rate: float = 1.0
     master_rate: float = 4.0  # checks per second that the master still knows the monitor
-    overload_actions: List[str] = field(default_factory=list)  # run while messages are dropped
+    overload_actions: List[str] = field(default_factory=list)  # run while messages are dropped or seen late
     queue_size: int = 100000  # messages the engine's queue holds
     state_file: Optional[str] = None  # latched actions kept across restarts; None: off
     error_actions: List[str] = field(default_factory=list)  # run while a field cannot be read
@@ -52,7 +52,7 @@ HELP = """  ~spec (string, required)          the RuBaSS spec to enforce
   ~node_rate (Hz, 0.1 to 100, 10)   node samples for alive, cpu, memory
   ~diagnostics_rate (Hz, 0.1 to 10, 1)  /diagnostics publications
   ~master_rate (Hz, 0.1 to 100, 4)  checks that the master still knows the monitor
-  ~overload_actions (list, [])      actions to run while the monitor drops messages
+  ~overload_actions (list, [])      actions to run while the monitor drops messages or sees them 0.5 s late
   ~queue_size (int, 10 to 10000000, 100000)  messages the engine's queue holds
   ~error_actions (list, [])         actions to run while a field cannot be read
   ~state_file (path or false, under $ROS_HOME/rubass/)  latched actions kept across the

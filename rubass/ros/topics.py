@@ -18,7 +18,6 @@ import genpy.dynamic
 import roslib.message
 import rospy
 
-from ..actions.overload import LATE
 from ..engine.values import UNKNOWN, UNREADABLE
 from ..lang import ast
 from ..lang.fielduse import field_needs
@@ -238,13 +237,6 @@ class TopicWatcher:
         if chosen == "rospy":
             return "rospy's threads (~receiver: rospy)"
         return "rospy's threads (this rospy connects subscribers differently, see the log)"
-
-    def read_late(self) -> str:
-        """For /diagnostics: how late the receiver read since the last status, when it is LATE or later."""
-        behind = self.receiver.take_behind(1) if self.receiver is not None else 0.0
-        if behind < LATE:
-            return "no"
-        return f"{behind:.2f} s (messages waited that long in the sockets' buffers: the monitor cannot keep up)"
 
     def _unroute(self, state: TopicState) -> None:
         if self.receiver is not None:

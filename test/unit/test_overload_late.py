@@ -1,7 +1,8 @@
-"""The overload fail-safe starts on late reading as on dropped messages (rubass/actions/overload.py):
-a monitor whose one receiving thread cannot keep up drops nothing, its messages wait in the
-sockets' buffers, and the rules see the robot that late."""
-from rubass.actions.overload import LATE, OverloadGuard
+"""The overload fail-safe starts on late messages as on dropped ones (rubass/actions/overload.py):
+a monitor that cannot keep up drops nothing until its queue is full: its messages wait in the
+sockets' buffers (its receiving thread reads late) or in the engine's queue (its engine evaluates
+late), and the rules see the robot, and act, that late."""
+from rubass.actions.overload import LATE, QUEUE, OverloadGuard, late_status
 
 
 class Runner:
@@ -50,3 +51,23 @@ def test_without_fail_safe_actions_nothing_runs():
     g = OverloadGuard([], 1.0, lambda level, text: logs.append(text), lambda e: None)
     g.check(0, 10.0, {}, lambda name: False, behind=5.0)
     assert not g.active and logs == [] and not g.would_start(0, 5.0)
+
+
+def test_messages_waiting_in_the_engines_queue_start_the_fail_safe_and_say_so():
+    g, logs, events = guard()
+    runners = {"stop": Runner()}
+    g.check(0, 10.0, runners, lambda name: False, behind=0.94, where=QUEUE)
+    assert g.active and g.reason == "evaluating its messages 0.94 s late"
+    assert logs == [("error", "overloaded: its messages are evaluated 0.94 s late (they wait in the engine's queue: "
+                              "it cannot keep up; its actions come that late): running the fail-safe actions stop "
+                              "(~overload_actions)")]
+    assert runners["stop"].got == ["start"]
+
+
+def test_the_status_names_the_later_of_the_sockets_and_the_queue():
+    assert late_status(0.0, 0.0) == "no"
+    assert late_status(LATE * 0.99, LATE * 0.99) == "no"
+    assert late_status(0.7, 0.2) == ("0.70 s (messages waited that long in the sockets' buffers: the monitor cannot "
+                                     "keep up)")
+    assert late_status(0.2, 1.25) == ("1.25 s (messages waited that long in the engine's queue: the monitor cannot "
+                                      "keep up)")
