@@ -12,7 +12,6 @@ from __future__ import annotations
 
 import threading
 import time
-import warnings
 from typing import Any, Dict, Optional, Tuple
 
 import roslib.message
@@ -23,7 +22,7 @@ from ..reach import Reach
 from .arbiter import take_seat
 from ...actions.base import ActionPlugin, Context, Skipped
 from ...actions.status import NOTHING_DONE, RESOLVED, topic_shown
-from .publish import ros_class
+from .publish import action_publisher, ros_class
 
 LOG_EVERY = 5.0
 # the latest well-typed command on each input, by (resolved name, message type): what came is a
@@ -56,9 +55,7 @@ class LimitPlugin(ActionPlugin):
     def setup(self) -> None:
         self.cls = ros_class(roslib.message.get_message_class, self.type, f"action '{self.name}'", "message")
         self.stamped = self.type.endswith("Stamped")
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")  # synchronous publisher on purpose, as in `publish`
-            self.pub = rospy.Publisher(self.params["topic"], self.cls, queue_size=None, tcp_nodelay=True)
+        self.pub = action_publisher(self.params["topic"], self.cls)
         self.seat = take_seat(self.params["topic"], self.name, self.action.priority, self._handed_over)
         self.input = rospy.resolve_name(self.params["input"])
         self.sub = rospy.Subscriber(self.params["input"], rospy.AnyMsg, self._on_input, tcp_nodelay=True)

@@ -1,7 +1,7 @@
 """The `publish` plugin: a message once at start and then at its rate while active."""
 from __future__ import annotations
 
-import warnings
+import time
 from typing import Any, Dict, Optional
 
 import genpy
@@ -57,6 +57,30 @@ class _Sink:
         pass
 
 
+PER_SUBSCRIBER_QUEUE = 10  # messages kept for a subscriber that does not read (the oldest go first)
+
+
+def action_publisher(topic: str, cls: Any) -> rospy.Publisher:
+    """An action's publisher: each subscriber's connection written by a rospy thread of its own.
+
+    Written synchronously (queue_size None), one subscriber that stops reading (a node stopped,
+    a link cut: TCP keeps its connection for up to 15 min) fills its socket's buffer and then
+    blocks the write to every other subscriber: the base stopped receiving the stop 35 s after a
+    recorder's link was cut, while ~heartbeat went on. Queued, that subscriber loses its own
+    oldest messages only; the cost is one thread hand-off per publication."""
+    return rospy.Publisher(topic, cls, queue_size=PER_SUBSCRIBER_QUEUE, tcp_nodelay=True)
+
+
+def flush(pub: rospy.Publisher, timeout: float = 0.5) -> None:
+    """Wait (at most `timeout`) until each subscriber's thread has taken what was handed to it: an
+    `on_release` published as the monitor stops reaches the subscribers that read before the
+    publisher closes their connections (one that does not read is not waited for longer)."""
+    end = time.monotonic() + timeout
+    for conn in list(getattr(pub.impl, "connections", None) or []):
+        while getattr(conn, "_queue", None) and time.monotonic() < end:  # rospy's QueuedConnection
+            time.sleep(0.005)
+
+
 class PublishPlugin(ActionPlugin):
     def __init__(self, action: Any) -> None:
         super().__init__(action)
@@ -73,12 +97,7 @@ class PublishPlugin(ActionPlugin):
         self.stamp = stamps_itself(cls, self.params.get("message") or {})
         self.release_stamp = release is not None and stamps_itself(cls, release)
         # Created at start-up, so that subscribers are connected before the first violation.
-        # Synchronous (queue_size None): the message is written from this action's runner thread
-        # rather than handed to one more rospy thread, which saves a thread hand-off (~40 µs at
-        # p50) on every stop. A subscriber that blocks the write blocks only this runner.
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")  # rospy warns that queue_size is not set: on purpose
-            self.pub = rospy.Publisher(self.params["topic"], cls, queue_size=None, tcp_nodelay=True)
+        self.pub = action_publisher(self.params["topic"], cls)
         # among the actions on this topic only the highest-priority active one publishes (§16)
         self.seat = take_seat(self.params["topic"], self.name, self.action.priority, lambda: self.wake())
 
@@ -106,8 +125,12 @@ class PublishPlugin(ActionPlugin):
                           f"no one; it is sent again as soon as one does")
 
     def periodic(self) -> None:
-        if self.active and self.pub is not None:
-            self._publish(self.msg, self.stamp)
+        if self.active and self.pub is not None and self._publish(self.msg, self.stamp) \
+                and self.pub.get_num_connections() == 0:
+            # the subscriber that took the start has gone (killed, its link cut): an active stop
+            # that reaches no one is a failure, shown until a publication reaches one again
+            raise IOError(f"{self.reach.why(self.params['topic'], self.params['type'])}: the message reached "
+                          f"no one; it is sent again at {float(self.params['rate']):g} Hz")
 
     def release(self, ctx: Context) -> Any:
         try:
@@ -125,5 +148,6 @@ class PublishPlugin(ActionPlugin):
         if self.seat is not None:
             self.seat.leave()
         if self.pub is not None:
+            flush(self.pub)
             self.pub.unregister()
             self.pub = None
