@@ -45,6 +45,7 @@ import threading
 import time
 from typing import Any, Callable, Dict, List, Optional, Tuple
 
+import genpy
 import rosgraph
 import rospy
 from std_msgs.msg import String
@@ -80,7 +81,7 @@ from .priority import describe, thread_nice_values
 from .exiting import EXIT_GRACE, exit_within
 from .reloading import ConfigError, Reloading, StartupError, said_if_slow
 from . import receiver
-from .topics import TopicWatcher, ros_now
+from .topics import TopicWatcher, message_bytes, ros_now
 
 _mono = time.monotonic
 
@@ -333,7 +334,7 @@ class Monitor(Reloading):
         self.agents = AgentBook()  # cpu and memory of nodes on other hosts, from their agents
         # the nodes of other hosts read unknown, and say why, until it is registered
         _register_aside(f"subscribe to {AGENT_TOPIC}", lambda: rospy.Subscriber(
-            AGENT_TOPIC, String, self._on_agent, queue_size=100, tcp_nodelay=True))
+            AGENT_TOPIC, rospy.AnyMsg, self._on_agent, queue_size=100, tcp_nodelay=True))
         self.sampler = self._sampler(spec)
         self.load_error = ""
         rospy.loginfo("rubass: enforcing %s (%s)", spec.path, ", ".join(  # distinct topics
@@ -431,11 +432,17 @@ class Monitor(Reloading):
     def _on_spellings(self, topics: Tuple[str, ...], now: float, msg: Any, wall: float, size: int) -> None:
         self.loop.submit(Message(topics[0], now, msg, wall, size, topics[1:], _mono()))
 
-    def _on_agent(self, msg: String) -> None:
+    def _on_agent(self, raw: Any) -> None:
+        """An agent's report (subscribed as rospy.AnyMsg, as the spec's topics are: a spec may name
+        the agents' topic, and rospy gives both subscribers the first one's class)."""
+        header = getattr(raw, "_connection_header", None) or {}
         try:
-            caller = getattr(msg, "_connection_header", {}).get("callerid") or None  # the publishing node
-            self.agents.update(decode_agent_report(msg.data), time.monotonic(), caller)
-        except ValueError as exc:
+            if header.get("type", String._type) != String._type:
+                raise ValueError(f"a {header.get('type')} message from {header.get('callerid', '?')}, not {String._type}")
+            msg = String()
+            msg.deserialize(message_bytes(raw))
+            self.agents.update(decode_agent_report(msg.data), time.monotonic(), header.get("callerid") or None)
+        except (ValueError, genpy.DeserializationError) as exc:
             rospy.logwarn_throttle(10, f"rubass: ignoring a bad report on {AGENT_TOPIC}: {exc}")
 
     def _on_node(self, node: str, now: float, alive: Any, cpu: Any, memory: Any) -> None:

@@ -7,6 +7,7 @@ connections are read by the receiver's one thread (receiver.py), which calls `_o
 each message's bytes; rospy's threads call `_callback` where the receiver gives a connection back."""
 from __future__ import annotations
 
+import io
 import queue
 import threading
 import time
@@ -36,6 +37,19 @@ def ros_now() -> float:
     if _rostime._rostime_current is None and _rostime._rostime_initialized:
         return time.time()
     return _rostime.get_rostime().to_sec()
+
+
+def message_bytes(raw: Any) -> bytes:
+    """A delivered message's serialised bytes. rospy gives every subscriber of a topic in one process
+    the class of the first: the spec's `rospy.AnyMsg` (its bytes), or, on a topic rospy itself or
+    another part of the monitor subscribed first with a type (`/clock` under use_sim_time, the
+    agents' topic), that type's message, serialised again here."""
+    buff = getattr(raw, "_buff", None)
+    if buff is not None:
+        return buff
+    out = io.BytesIO()
+    raw.serialize(out)
+    return out.getvalue()
 
 
 Submit = Callable[[str, float, Any, float, int], None]  # (spec topic, ROS time, message or None, wall, bytes)
@@ -271,8 +285,8 @@ class TopicWatcher:
                 self.submit(alias, now, msg, wall, 0)
 
     def _callback(self, raw: Any, state: TopicState) -> None:
-        """A message through rospy's own delivery (an rospy.AnyMsg)."""
-        self._on_frame(raw._buff, getattr(raw, "_connection_header", None) or {}, state)
+        """A message through rospy's own delivery (an rospy.AnyMsg, or a typed one: see message_bytes)."""
+        self._on_frame(message_bytes(raw), getattr(raw, "_connection_header", None) or {}, state)
 
     def _on_frame(self, buff: bytes, header: Dict[str, str], state: TopicState) -> None:
         """One message of a watched topic: its serialised bytes and its connection's header."""
