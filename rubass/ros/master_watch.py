@@ -33,6 +33,7 @@ from typing import Any, Callable, Optional, Tuple, Union
 from rospy.impl.registration import RegManager, get_registration_listeners, get_service_manager, get_topic_manager
 
 from . import rpc
+from .reconnect import PERIOD as LOST_PERIOD, LostConnections
 
 Log = Callable[[str, str], None]
 MONITOR_UNREACHABLE = ("existing connections keep working and the rules keep being enforced; nodes started now "
@@ -98,6 +99,9 @@ class MasterWatch:
         self.down_since: Optional[float] = None  # monotonic time of the first failed poll
         self.master_pid: Optional[int] = None  # the process that answered the last poll
         self._caller = rpc.Caller(master_uri, timeout)  # polled: one kept connection
+        # subscriptions whose connection ended while the master lists the publisher (reconnect.py)
+        self.lost = LostConnections(caller_id, master_uri, log, timeout)
+        self._lost_at = 0.0  # when they were last looked for
         self._stop = threading.Event()
         self._thread: Optional[threading.Thread] = None
 
@@ -110,11 +114,16 @@ class MasterWatch:
         if self._thread is not None:
             self._thread.join(2.0)
         self._caller.close()
+        self.lost.close()
 
     def _run(self) -> None:
         while not self._stop.wait(self.period):
             try:
-                self.check()
+                if self.check() != "unreachable" and time.monotonic() - self._lost_at >= LOST_PERIOD:
+                    self._lost_at = time.monotonic()
+                    manager = _reg_manager()
+                    if manager is not None:
+                        self.lost.check(manager.publisher_update)
             except Exception as exc:  # never let the watch die: log and poll again
                 self.log("error", f"master watch: {exc.__class__.__name__}: {exc}")
 
