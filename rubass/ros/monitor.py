@@ -241,8 +241,8 @@ class Monitor(Reloading):
                      "~heartbeat (a watchdog fed by it stops the robot); fix the file, then SIGHUP or "
                      "rosservice call ~reload", error)
 
-    def _status_failed(self, exc: Exception) -> None:
-        """An ERROR status saying why the full one is missing (e.g. the engine's thread stalled)."""
+    def _status_failed(self, exc: Exception) -> str:
+        """An ERROR status saying why the full one is missing (e.g. the engine's thread stalled); the why."""
         why = "the engine's thread did not answer (stalled?)" if isinstance(exc, (queue.Empty, queue.Full)) \
             else f"{exc.__class__.__name__}: {exc}"
         if isinstance(exc, (queue.Empty, queue.Full)) and self.overload.active:  # it answers behind the queue
@@ -251,8 +251,9 @@ class Monitor(Reloading):
         try:
             self.outputs.status([status_mod.Entry("rubass: monitor", status_mod.ERROR, f"STATUS UNAVAILABLE: {why}",
                                                   [("spec", self.config.spec)])], _ros_now())
-        except Exception:  # publishing itself failed: the log line above is all there is
+        except Exception:  # publishing itself failed: the log line is all there is
             pass
+        return why
 
     def _why_not(self) -> str:
         """Why the monitor is not enforcing (before its engine runs)."""
@@ -456,8 +457,7 @@ class Monitor(Reloading):
             try:
                 self.publish_status()
             except Exception as exc:  # the status must never take the monitor down, nor go silent
-                rospy.logerr_throttle(10, f"rubass: status failed: {exc.__class__.__name__}: {exc}")
-                self._status_failed(exc)
+                rospy.logerr_throttle(10, f"rubass: status unavailable: {self._status_failed(exc)}")
             self._exit.wait(period)
         self.shutdown()
         rospy.signal_shutdown("rubass monitor stopped")

@@ -91,7 +91,8 @@ class Receiver:
         self._links: Dict[int, _Link] = {}  # by socket fd
         self._lock = threading.Lock()  # _routes and _new, for moments
         self._closed = False
-        self.given_back = 0  # connections handed to rospy's threads
+        self.given_back = 0  # connections handed to rospy's threads, since start
+        self._given: List[Any] = []  # those connections, while rospy's threads read them
         self.failed = ""  # why the receiver gave every connection back, if it did
         self._behind = [0.0, 0.0]  # the latest evaluation after its data arrived, since `take_behind(0)`, `(1)`
         self._busy_since = 0.0  # when the wait on the sockets last returned, while what it returned is handled
@@ -138,7 +139,10 @@ class Receiver:
         """For /diagnostics: who reads the watched topics' connections."""
         if self.failed:
             return f"rospy's threads (the receiver failed: {self.failed})"
-        given = f", {self.given_back} given to rospy's threads" if self.given_back else ""
+        with self._lock:
+            self._given = [c for c in self._given if not c.done]
+            n = len(self._given)
+        given = f", {n} given to rospy's threads" if n else ""
         return f"one thread, {len(self._links)} connection{'s' if len(self._links) != 1 else ''}{given}"
 
     def close(self) -> None:
@@ -393,6 +397,8 @@ class Receiver:
         buff.write(bytes(link.rest))  # rospy's receive_once reads what it holds first
         link.rest.clear()
         self.given_back += 1
+        with self._lock:
+            self._given.append(conn)
         threading.Thread(target=_rospy_reads, args=(conn, link.impl, msgs), name=link.topic, daemon=True).start()
 
 

@@ -220,6 +220,7 @@ def test_another_callback_on_the_topic_gives_the_connection_back_to_a_rospy_thre
     assert receiver.given_back == 1 and "1 given to rospy's threads" in receiver.describe()
     pub.close()
     assert until(lambda: conn.done)
+    assert "given" not in receiver.describe()  # ended: no longer read by anyone
 
 
 def test_a_latched_connection_keeps_its_latest_message_for_a_later_callback(receiver):
