@@ -100,7 +100,7 @@ class MasterWatch:
         self.master_pid: Optional[int] = None  # the process that answered the last poll
         self._caller = rpc.Caller(master_uri, timeout)  # polled: one kept connection
         # subscriptions whose connection ended while the master lists the publisher (reconnect.py)
-        self.lost = LostConnections(caller_id, master_uri, log, timeout)
+        self.lost = LostConnections(caller_id, master_uri, log, timeout, node_uri)
         self._lost_at = 0.0  # when they were last looked for
         self._stop = threading.Event()
         self._thread: Optional[threading.Thread] = None

@@ -11,12 +11,22 @@ subscription of its process, the publishers the master lists (`getSystemState`, 
 its live connections, and, for a publisher missing two checks in a row (a new one is still
 being connected), hands rospy the master's list, as a `publisherUpdate` would: rospy connects to
 each listed publisher it has no connection to, retrying as it does at subscription.
+
+The other way round, the robot's nodes' subscriptions to what the monitor publishes (its stops,
+`~heartbeat`) end the same way, and their rospy or roscpp does not connect again either: the
+monitor cannot make them, but a `registerPublisher` of that topic makes the master send every
+subscriber a `publisherUpdate`, at which each connects to a publisher it has no connection to.
+So a subscriber that was connected, lost, and is still listed by the master two checks in a row
+gets that, again after 4, 8, … up to 60 s while it stays lost (a node killed without
+unregistering stays listed until `rosnode cleanup`: the master then calls it in vain, once a
+minute at most).
 """
 from __future__ import annotations
 
 import socket
+import time
 import xmlrpc.client
-from typing import Callable, Dict, List, Set, Tuple
+from typing import Any, Callable, Dict, List, Set, Tuple
 
 from rospy.impl.registration import get_topic_manager
 
@@ -29,9 +39,12 @@ PERIOD = 2.0  # s between checks
 class LostConnections:
     """Run `check()` every PERIOD (the master watch does, while the master answers)."""
 
-    def __init__(self, caller_id: str, master_uri: str, log: Log, timeout: float = 0.5) -> None:
-        self.caller_id, self.log = caller_id, log
+    def __init__(self, caller_id: str, master_uri: str, log: Log, timeout: float = 0.5, node_uri: str = "") -> None:
+        self.caller_id, self.log, self.node_uri = caller_id, log, node_uri
         self.reconnected = 0  # connections handed back to rospy to connect again, since start
+        self.reannounced = 0  # publications registered again for a subscriber that lost its connection
+        self._subscribers: Dict[str, Set[str]] = {}  # our topic -> subscriber nodes connected at some check
+        self._lost_subs: Dict[Tuple[str, str], Tuple[int, float]] = {}  # (topic, node) -> (checks lost, next try)
         self._caller = rpc.Caller(master_uri, timeout)
         self._uris: Dict[str, str] = {}  # publisher node -> its XML-RPC URI, as the master last said
         self._missing: Set[Tuple[str, str]] = set()  # (topic, uri) missing at the last check
@@ -44,12 +57,15 @@ class LostConnections:
         connections it asked rospy to make again."""
         tm = get_topic_manager()
         topics = [name for name, _ in tm.get_subscriptions()]
-        if not topics:
+        publications = tm.get_publications()
+        if not topics and not publications:
             return 0
         try:
-            publishers = dict(self._caller.call("getSystemState", self.caller_id)[2][0])
+            state = self._caller.call("getSystemState", self.caller_id)[2]
+            publishers, subscribers = dict(state[0]), dict(state[1])
         except (OSError, socket.error, xmlrpc.client.Error, IndexError, TypeError, ValueError):
             return 0  # the master watch says when the master cannot be reached
+        self._announce(tm, publications, subscribers)
         missing: Set[Tuple[str, str]] = set()
         asked = 0
         for topic in topics:
@@ -74,6 +90,38 @@ class LostConnections:
         self._missing = missing
         self.reconnected += asked
         return asked
+
+    def _announce(self, tm: Any, publications: List[Tuple[str, str]], listed: Dict[str, List[str]]) -> None:
+        """Register again a publication a listed subscriber has lost its connection to (see above)."""
+        now = time.monotonic()
+        lost: Dict[Tuple[str, str], Tuple[int, float]] = {}
+        for topic, type_name in publications:
+            impl = tm.get_publisher_impl(topic)
+            if impl is None:
+                continue
+            have = {c.endpoint_id for c in list(impl.connections) if not getattr(c, "done", False)}
+            seen = self._subscribers.setdefault(topic, set())
+            seen |= have
+            gone = [n for n in listed.get(topic, []) if n in seen and n not in have and n != self.caller_id]
+            due = []
+            for node in gone:
+                checks, at = self._lost_subs.get((topic, node), (0, 0.0))
+                checks += 1
+                if checks >= 2 and now >= at:
+                    due.append(node)
+                    at = now + min(60.0, 4.0 * 2 ** min(checks - 2, 4))
+                lost[(topic, node)] = (checks, at)
+            if due and self.node_uri:
+                try:
+                    self._caller.call("registerPublisher", self.caller_id, topic, type_name, self.node_uri)
+                except (OSError, socket.error, xmlrpc.client.Error, ValueError):
+                    continue
+                self.reannounced += 1
+                self.log("warn", f"topic {topic}: subscriber {', '.join(due)} lost its connection to the monitor while "
+                                 f"the master still lists it (a link cut longer than TCP's keepalive?); its rospy does "
+                                 f"not connect again by itself: registered the publication again, so that the master "
+                                 f"tells it to")
+        self._lost_subs = lost
 
     def _uri(self, node: str, have: Set[str]) -> str:
         """The node's URI: the one known, if a connection to it is live; else asked of the master."""

@@ -51,3 +51,37 @@ def test_a_connection_that_ended_while_its_publisher_stays_registered_is_made_ag
     out, _ = brakes.communicate(timeout=30)
     assert '"data": true' in out, ros.log(mon)  # the violation after the reconnection is stopped
     assert int(monitor_values(ros)["connections made again"]) >= 1
+
+
+BASE = """
+import time
+import rospy
+from std_msgs.msg import Bool
+rospy.init_node("base")
+got = []
+sub = rospy.Subscriber("/brake", Bool, lambda m: got.append(time.time()), tcp_nodelay=True)
+end = time.time() + 20
+while not got and time.time() < end:
+    time.sleep(0.05)
+print("braking" if got else "no brake", flush=True)
+time.sleep(3.0)  # connected a while (the monitor looks every 2 s): one it had, then lost
+for c in list(sub.impl.connections):  # its subscription ends as after a long cut: still registered
+    c.close()
+cut = time.time()
+time.sleep(0.5)
+end = time.time() + 15
+while not [t for t in got if t > cut + 0.5] and time.time() < end:
+    time.sleep(0.05)
+print("braking again" if [t for t in got if t > cut + 0.5] else "no brake since", flush=True)
+"""
+
+
+def test_a_subscriber_whose_connection_ended_is_told_through_the_master_to_connect_again(ros, tmp_path):
+    mon = ros.monitor(spec(tmp_path, BODY))
+    base = ros.spawn([PY, "-c", BASE], "base", stdout=subprocess.PIPE, text=True)
+    ros.probe({"advertise": [{"topic": "/cmd_vel", "type": "geometry_msgs/Twist"}],
+               "steps": [{"wait_subscribers": "/cmd_vel"}, {"sleep": 0.3},
+                         {"publish": "/cmd_vel", "msg": {"linear": {"x": 2.0}}}, {"sleep": 0.5}]})
+    assert base.stdout.readline().strip() == "braking", ros.log(mon)
+    assert base.stdout.readline().strip() == "braking again", ros.log(mon)
+    assert "topic /brake: subscriber /base lost its connection to the monitor" in ros.log(mon)

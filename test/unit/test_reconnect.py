@@ -13,12 +13,17 @@ from rubass.ros import reconnect  # noqa: E402
 class Master:
     def __init__(self):
         self.publishers = {"/cmd_vel": ["/driver"]}
+        self.subscribers = {"/stop": ["/base"]}
         self.uris = {"/driver": "http://robot:4000/"}
         self.lookups = 0
+        self.registered = []
 
     def call(self, method, *args):
         if method == "getSystemState":
-            return 1, "", [list(self.publishers.items()), [], []]
+            return 1, "", [list(self.publishers.items()), list(self.subscribers.items()), []]
+        if method == "registerPublisher":
+            self.registered.append(args[1:])
+            return 1, "", []
         self.lookups += 1
         return 1, "", self.uris[args[1]]
 
@@ -26,13 +31,18 @@ class Master:
         pass
 
 
-def watcher(monkeypatch, connections):
+def watcher(monkeypatch, connections, subscribers=()):
     impl = SimpleNamespace(connections=connections)
+    pub = SimpleNamespace(connections=list(subscribers))
     tm = SimpleNamespace(get_subscriptions=lambda: [("/cmd_vel", "geometry_msgs/Twist")],
-                         get_subscriber_impl=lambda topic: impl)
+                         get_subscriber_impl=lambda topic: impl,
+                         get_publications=lambda: [("/stop", "geometry_msgs/Twist")],
+                         get_publisher_impl=lambda topic: pub)
     monkeypatch.setattr(reconnect, "get_topic_manager", lambda: tm)
     logs = []
-    lost = reconnect.LostConnections("/rubass", "http://master:11311/", lambda level, text: logs.append((level, text)))
+    lost = reconnect.LostConnections("/rubass", "http://master:11311/", lambda level, text: logs.append((level, text)),
+                                     node_uri="http://monitor:5000/")
+    lost.pub = pub
     lost._caller = Master()
     return lost, logs
 
@@ -62,3 +72,29 @@ def test_a_connection_that_ended_counts_as_lost(monkeypatch):
     lost.check(lambda topic, uris: asked.append(uris))
     lost.check(lambda topic, uris: asked.append(uris))
     assert asked == [["http://robot:4000/"]]
+
+
+def test_a_subscriber_that_lost_its_connection_is_told_again_through_the_master_with_backoff(monkeypatch):
+    base = SimpleNamespace(endpoint_id="/base", done=False)
+    lost, logs = watcher(monkeypatch, connections=[SimpleNamespace(endpoint_id="http://robot:4000/", done=False)],
+                         subscribers=[base])
+    master = lost._caller
+    lost.check(lambda topic, uris: None)  # /base connected: seen
+    lost.pub.connections = []  # its connection ended; the master still lists it
+    lost.check(lambda topic, uris: None)
+    assert master.registered == []  # one check: it may be a moment's
+    lost.check(lambda topic, uris: None)
+    assert master.registered == [("/stop", "geometry_msgs/Twist", "http://monitor:5000/")]
+    assert lost.reannounced == 1 and "topic /stop: subscriber /base lost its connection" in logs[-1][1]
+    lost.check(lambda topic, uris: None)
+    assert len(master.registered) == 1  # not again before the backoff (4 s)
+    lost.pub.connections = [base]  # it connected again
+    lost.check(lambda topic, uris: None)
+    assert lost._lost_subs == {}
+
+
+def test_a_subscriber_never_connected_is_not_announced_to(monkeypatch):
+    lost, _ = watcher(monkeypatch, connections=[SimpleNamespace(endpoint_id="http://robot:4000/", done=False)])
+    for _ in range(4):
+        lost.check(lambda topic, uris: None)
+    assert lost._caller.registered == []  # /base listed but never connected: not ours to chase
