@@ -384,20 +384,23 @@ class Monitor(Reloading):
         return "; ".join(f"{', '.join(w.actions)} ({w.holder})" for w in self.withheld)
 
     def _tick(self, now: float) -> None:
-        """On the engine's thread at each tick: the heartbeat (unless withheld), then the overload check."""
-        if not self.withheld:
-            self.outputs.beat(now)
+        """On the engine's thread at each tick: the heartbeat (unless withheld, or the monitor sees its
+        messages LATE or later), then the overload check."""
         loop = self.loop
         assert loop is not None
-        was = self.overload.active
         reader = self.watcher.receiver
         read = reader.take_behind() if reader is not None else 0.0  # how late the receiver reads
         waited = loop.take_waited()  # and how long messages wait in the engine's queue after it
         behind, where = (waited, QUEUE) if waited > read else (read, SOCKETS)
+        # a busy engine still ticks between messages: a beat then would feed the robot's watchdog
+        # while the rules run seconds behind (a reviewer's finding), so none while it is late
+        if not self.withheld and behind < LATE:
+            self.outputs.beat(now)
+        was = self.overload.active
         if behind >= LATE and not self.overload.actions:  # with them, the fail-safe's start says it
             what, waits = lateness(behind, where)
             rospy.logwarn_throttle(10, f"rubass: {what} ({waits}: the monitor cannot keep up); no ~overload_actions "
-                                       f"are set")
+                                       f"are set; no ~heartbeat while it is late")
         if not was and self.overload.would_start(loop.dropped, behind):  # written before the fail-safe runs
             self.keeper.save(loop.engine, self.dispatcher.orphans, self._fail_safes(starting=True))
         self.overload.check(loop.dropped, now, self.dispatcher.runners, lambda name: loop.engine.spec.actions[name].latch,

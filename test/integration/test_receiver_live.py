@@ -206,7 +206,8 @@ def test_an_engine_that_cannot_keep_up_runs_the_overload_fail_safe_long_before_i
                     for i in range(3000))
     body = "entity a { rules:\n  fast: topic /cmd_vel.linear.x > 1;\n" + rules + "}\nif (a.fast) then { stop; }\n"
     mon = ros.monitor(spec(tmp_path, body), overload_actions="[brake]")
-    diag = ros.probe_bg({"listen": [{"topic": "/diagnostics", "type": "diagnostic_msgs/DiagnosticArray"}],
+    diag = ros.probe_bg({"listen": [{"topic": "/diagnostics", "type": "diagnostic_msgs/DiagnosticArray"},
+                                    {"topic": "/rubass/heartbeat", "type": "std_msgs/Header"}],
                          "steps": [{"wait_publishers": "/diagnostics"}, {"mark": "ready"}, {"sleep": 12.0}]},
                         name="diag")
     assert '"ready"' in diag.stdout.readline()
@@ -218,8 +219,14 @@ def test_an_engine_that_cannot_keep_up_runs_the_overload_fail_safe_long_before_i
     assert "overloaded: its messages are evaluated" in log and "(they wait in the engine's queue" in log, log
     out, _ = diag.communicate(timeout=60)
     rec = [json.loads(x) for x in out.splitlines() if x.startswith("{")]
-    said = [s["message"] for r in rec if r["kind"] == "recv" for s in r["msg"]["status"] if s["name"] == "rubass: monitor"]
+    said = [s["message"] for r in rec if r["kind"] == "recv" and r["topic"] == "/diagnostics"
+            for s in r["msg"]["status"] if s["name"] == "rubass: monitor"]
     # the status says it, or, when the engine did not answer it within 5 s behind its queue, why not
     assert any("OVERLOADED, evaluating its messages" in m for m in said), said
+    # the busy engine still ticks between queued messages; its heartbeat must not say it keeps up
+    beats = [r["wall"] for r in rec if r["kind"] == "recv" and r["topic"] == "/rubass/heartbeat"]
+    during = [b for b in beats if got["go"] <= b <= got["end"] + 1.0]
+    gaps = [b - a for a, b in zip([got["go"]] + during, during + [got["end"] + 1.0])]
+    assert max(gaps) >= 1.0, (len(during), max(gaps))
     wait_log(mon, ros, "overload over (no message dropped or read 0.5 s late for 1 s): releasing brake", 60)
     assert monitor_values(ros)["dropped messages"] == "0"  # the queue took them all: late, not lost
