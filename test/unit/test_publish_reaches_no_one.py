@@ -70,3 +70,15 @@ def test_closing_waits_for_each_subscribers_thread_to_take_its_messages_but_not_
     t0 = time.monotonic()
     publish.flush(SimpleNamespace(impl=SimpleNamespace(connections=[reading])), timeout=5.0)
     assert time.monotonic() - t0 < 0.1  # nothing waiting: no wait
+
+
+def test_a_stop_that_never_reached_anyone_is_not_shown_resolved_once_it_is_released():
+    """A reviewer's sequence: the start fails (no one), periodic fails during its backoff, the
+    behaviour is released; the next periodic, inactive, sent nothing and must resolve nothing."""
+    p = active(subscribers=0)
+    runner = ActionRunner(p, lambda level, text: None)
+    assert not runner._guard("start", lambda: p.start(None))
+    assert not runner._guard("periodic", p.periodic)
+    p.active = False  # released
+    assert runner._guard("periodic", p.periodic)  # nothing to do: not a failure
+    assert runner.stats.failing == "periodic" and not runner.stats.last_error.startswith("resolved")

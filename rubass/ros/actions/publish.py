@@ -124,13 +124,15 @@ class PublishPlugin(ActionPlugin):
             raise IOError(f"{self.reach.why(self.params['topic'], self.params['type'])}: the message reached "
                           f"no one; it is sent again as soon as one does")
 
-    def periodic(self) -> None:
-        if self.active and self.pub is not None and self._publish(self.msg, self.stamp) \
-                and self.pub.get_num_connections() == 0:
+    def periodic(self) -> Any:
+        if not (self.active and self.pub is not None and self._publish(self.msg, self.stamp)):
+            return NOTHING_DONE  # nothing sent: proves nothing (an inactive periodic must not show a failure resolved)
+        if self.pub.get_num_connections() == 0:
             # the subscriber that took the start has gone (killed, its link cut): an active stop
             # that reaches no one is a failure, shown until a publication reaches one again
             raise IOError(f"{self.reach.why(self.params['topic'], self.params['type'])}: the message reached "
                           f"no one; it is sent again at {float(self.params['rate']):g} Hz")
+        return None
 
     def release(self, ctx: Context) -> Any:
         try:
