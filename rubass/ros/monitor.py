@@ -547,7 +547,7 @@ class Monitor(Reloading):
             "overload cause": self.overload.reason if self.overload.active else "none",
             "failed action attempts": failures,  # every one ever, for the record (no action name has a space)
             "master": self.master_watch.state, "master re-registrations": self.master_watch.reregistrations,
-            "connections made again": self.master_watch.lost.reconnected + self.master_watch.lost.reannounced,
+            "connections made again": self.master_watch.lost.reconnected,
             "reaction latency p50 ms": f"{lat[len(lat) // 2] * 1000:.3f}" if lat else "n/a",
             "nice": self._nice(),
             "receiving": self.watcher.receiving(self.config.receiver),

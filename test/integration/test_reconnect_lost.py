@@ -21,7 +21,7 @@ while pub.get_num_connections() == 0:
     time.sleep(0.05)
 time.sleep(0.5)
 pub.publish(Twist())
-time.sleep(0.3)
+time.sleep(3.0)  # connected a while (the monitor looks every 2 s): one it had, then lost
 for c in list(pub.impl.connections):  # ends it as a dead link's keepalive would: still registered
     c.close()
 print("closed", flush=True)
@@ -42,12 +42,12 @@ time.sleep(1.0)
 def test_a_connection_that_ended_while_its_publisher_stays_registered_is_made_again(ros, tmp_path, receiver):
     mon = ros.monitor(spec(tmp_path, BODY), receiver=receiver)
     brakes = ros.probe_bg({"listen": [{"topic": "/brake", "type": "std_msgs/Bool"}],
-                           "steps": [{"wait_publishers": "/brake"}, {"mark": "ready"}, {"sleep": 11.0}]}, name="base")
+                           "steps": [{"wait_publishers": "/brake"}, {"mark": "ready"}, {"sleep": 14.0}]}, name="base")
     assert '"ready"' in brakes.stdout.readline()
     driver = ros.spawn([PY, "-c", DROPPER], "driver", stdout=subprocess.PIPE, text=True)
     assert driver.stdout.readline().strip() == "closed"
     assert driver.stdout.readline().strip() == "connected again", ros.log(mon)
-    wait_log(mon, ros, "topic /cmd_vel: the connection to its publisher /driver (http://", 5)
+    wait_log(mon, ros, "topic /cmd_vel: the connection from its publisher /driver had ended", 5)
     out, _ = brakes.communicate(timeout=30)
     assert '"data": true' in out, ros.log(mon)  # the violation after the reconnection is stopped
     assert int(monitor_values(ros)["connections made again"]) >= 1
