@@ -100,6 +100,7 @@ class EngineLoop:
         self._sleep_until = math.inf  # when the engine's thread wakes next by itself
         self.mono = mono
         self._waited = [0.0, 0.0]  # the longest a message waited in the queue, per asker (take_waited)
+        self._waited_lock = threading.Lock()  # the status thread takes its value while the engine notes one
 
     # -- any thread ----------------------------------------------------------------------
     def submit(self, item: Any) -> bool:
@@ -203,15 +204,17 @@ class EngineLoop:
     def take_waited(self, who: int = 0) -> float:
         """The longest a message waited in the queue before the engine took it (s), since `who` last
         asked (0: the tick's overload check, 1: the status)."""
-        waited, self._waited[who] = self._waited[who], 0.0
+        with self._waited_lock:
+            waited, self._waited[who] = self._waited[who], 0.0
         return waited
 
     def _note_wait(self, arrived: float) -> None:
         waited = self.mono() - arrived
-        if waited > self._waited[0]:
-            self._waited[0] = waited
-        if waited > self._waited[1]:
-            self._waited[1] = waited
+        with self._waited_lock:
+            if waited > self._waited[0]:
+                self._waited[0] = waited
+            if waited > self._waited[1]:
+                self._waited[1] = waited
 
     def stop(self) -> None:
         self._stop.set()
