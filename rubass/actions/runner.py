@@ -28,7 +28,7 @@ WATCH_EVERY = 0.25  # how often the watchdog looks at the calls in progress
 _GIVEN_UP = {"start": " (no longer retried: released before an attempt succeeded)",
              "release": " (no longer retried: started again before an attempt succeeded)"}
 _RESOLVED_BY = {"start": ("start", "release"), "release": ("release", "start"),
-                "hold": ("hold", "start", "release"), "periodic": ("periodic", "start"), "input": ()}
+                "hold": ("hold", "start", "release"), "periodic": ("periodic", "start", "release"), "input": ()}
 
 
 class ActionRunner:

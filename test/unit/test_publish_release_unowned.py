@@ -49,6 +49,7 @@ def plugin(mine, subscribers=1):
     p.msg, p.stamp, p.params = object(), False, {"topic": "/cmd"}
     p.release_msg, p.release_stamp, p.pub, p.seat = object(), False, Pub(subscribers), Seat(mine)
     p.params["type"] = "std_msgs/Bool"
+    p.reached = p.lost = False  # set up by __init__, which is skipped here
     p.reach = NoSubscriber()  # the master is not asked here: test/integration/test_publish_wrong_type.py
     return p
 

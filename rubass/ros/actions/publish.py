@@ -58,6 +58,8 @@ class _Sink:
 
 
 PER_SUBSCRIBER_QUEUE = 10  # messages kept for a subscriber that does not read (the oldest go first)
+LOST_AFTER = 10.0  # s an active stop may reach no one after its subscribers went before it is a failure
+_clock = time.monotonic  # LOST_AFTER's clock (a test moves it by hand)
 
 
 def action_publisher(topic: str, cls: Any) -> rospy.Publisher:
@@ -88,6 +90,9 @@ class PublishPlugin(ActionPlugin):
         self.pub: Optional[rospy.Publisher] = None
         self.seat: Any = None
         self.reach = Reach()
+        self.reached = False  # this activation's start reached a subscriber
+        self.gone_at: Optional[float] = None  # ... and every subscriber has gone since then (monotonic)
+        self.lost = False  # ... for LOST_AFTER: reported once, by periodic
 
     def setup(self) -> None:
         cls = ros_class(roslib.message.get_message_class, self.params["type"], f"action '{self.name}'", "message")
@@ -117,22 +122,35 @@ class PublishPlugin(ActionPlugin):
             # a higher-priority action owns the topic: nothing sent, nothing proved; retried (it is
             # this action's turn once that one releases; meanwhile a failed start stays shown)
             raise Skipped(f"{self.params['topic']} is held by a higher-priority action")
+        self.reached, self.gone_at, self.lost = False, None, False
         if self.pub.get_num_connections() == 0:
             # not an error rospy would report: the message just went nowhere. A failure, so it is
             # logged, counted in /diagnostics and retried (0.05 s, 0.1 s, … then every 1 s); the
             # periodic publication also reaches a subscriber that connects later.
             raise IOError(f"{self.reach.why(self.params['topic'], self.params['type'])}: the message reached "
                           f"no one; it is sent again as soon as one does")
+        self.reached = True
 
     def periodic(self) -> Any:
         if not (self.active and self.pub is not None and self._publish(self.msg, self.stamp)):
             return NOTHING_DONE  # nothing sent: proves nothing (an inactive periodic must not show a failure resolved)
-        if self.pub.get_num_connections() == 0:
-            # the subscriber that took the start has gone (killed, its link cut): an active stop
-            # that reaches no one is a failure, shown until a publication reaches one again
-            raise IOError(f"{self.reach.why(self.params['topic'], self.params['type'])}: the message reached "
-                          f"no one; it is sent again at {float(self.params['rate']):g} Hz")
-        return None
+        if self.pub.get_num_connections() > 0:
+            self.gone_at, self.lost = None, False
+            return None
+        if not self.reached or self.lost:
+            return NOTHING_DONE  # the start's own failure says it (retried), or this loss was reported
+        now = _clock()
+        if self.gone_at is None:
+            self.gone_at = now
+        if now - self.gone_at < LOST_AFTER:
+            return NOTHING_DONE  # a subscriber restarting, a probe that came and went: not yet
+        # every subscriber the start reached has gone for LOST_AFTER (the base killed, its link cut):
+        # an active stop that reaches no one is a failure, reported once and shown until a
+        # publication reaches one again or the stop is released
+        self.lost = True
+        raise IOError(f"{self.reach.why(self.params['topic'], self.params['type'])}: the message reached no one "
+                      f"for {now - self.gone_at:.0f} s since its subscribers went; it is sent again at "
+                      f"{float(self.params['rate']):g} Hz")
 
     def release(self, ctx: Context) -> Any:
         try:
@@ -140,10 +158,13 @@ class PublishPlugin(ActionPlugin):
                                                                                         self.release_stamp) \
                     and self.pub.get_num_connections() > 0:
                 return None
+            if self.lost:  # an active stop that reached no one since its subscribers went: no longer active
+                return None
             # nothing that reached anyone (no on_release, a higher-priority action owns the topic, no
             # subscriber): a failed start is not shown fixed by it
             return NOTHING_DONE
         finally:
+            self.reached, self.gone_at, self.lost = False, None, False
             self.seat.deactivate()  # after on_release: the next action on the topic is woken to publish
 
     def close(self) -> None:
