@@ -10,10 +10,8 @@ driver MODE HZ SECONDS   measure, printing one JSON line:
             (x=0) at HZ; the k-th stop on /bench/stop (std_msgs/Header) answers the k-th violation
 
 Every publisher on a measured path (echo, driver, timed) publishes synchronously
-(`queue_size=None`, the fastest rospy offers), so the raw hop is the lowest bar; the monitor's
-publish action writes each subscriber from a rospy thread of its own (queued: one stuck subscriber
-must not hold the stop from the others), one hand-off more on rubass's path; the background load
-goes through rospy's queue thread too.
+(`queue_size=None`), as the monitor's publish action does, so the raw hop and rubass's path pay
+the same publish; only the background load goes through rospy's queue thread.
 """
 import json
 import sys

@@ -6,10 +6,8 @@
     standing in for the base (two hops plus evaluation and dispatch); stops are matched to
     violations in order (the k-th stop to the k-th violation), and stops missing or extra
     are counted.
-(a) and (b) run one after the other in the same run, for each case; the benchmark's own
-publishers (echo, driver) publish synchronously (queue_size=None), the fastest rospy offers; the
-monitor's stop is queued per subscriber (one hand-off more, so that a stuck subscriber cannot hold
-it from the others).
+(a) and (b) run one after the other in the same run, for each case; every publisher on both
+paths publishes synchronously (queue_size=None), as the monitor's stop does.
 At 100 Hz and 1 kHz, alone and with background load (20 other topics at 100 Hz and 100
 other rules in the monitor). Prints one JSON object per case, with p50/p99/max of (a) and
 (b) and the ratio (b) / 2·(a) at the median. Targets: (b) p50 <= 2x the two raw hops and

@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import time
+import warnings
 from typing import Any, Dict, Optional
 
 import genpy
@@ -57,30 +58,43 @@ class _Sink:
         pass
 
 
-PER_SUBSCRIBER_QUEUE = 10  # messages kept for a subscriber that does not read (the oldest go first)
+SEND_TIMEOUT = 0.1  # s a write to one subscriber may block before that subscriber's connection is dropped
 LOST_AFTER = 10.0  # s an active stop may reach no one after its subscribers went before it is a failure
 _clock = time.monotonic  # LOST_AFTER's clock (a test moves it by hand)
 
 
 def action_publisher(topic: str, cls: Any) -> rospy.Publisher:
-    """An action's publisher: each subscriber's connection written by a rospy thread of its own.
+    """An action's publisher: written synchronously (no thread hand-off on the stop's way), each
+    subscriber's socket with a send timeout of SEND_TIMEOUT.
 
-    Written synchronously (queue_size None), one subscriber that stops reading (a node stopped,
-    a link cut: TCP keeps its connection for up to 15 min) fills its socket's buffer and then
-    blocks the write to every other subscriber: the base stopped receiving the stop 35 s after a
-    recorder's link was cut, while ~heartbeat went on. Queued, that subscriber loses its own
-    oldest messages only; the cost is one thread hand-off per publication."""
-    return rospy.Publisher(topic, cls, queue_size=PER_SUBSCRIBER_QUEUE, tcp_nodelay=True)
+    rospy writes each subscriber in turn: one that stops reading (a node stopped, a link cut: TCP
+    keeps its connection up to 15 min) fills its socket's buffers, and its write then blocked every
+    publication, to the base too (a tester's run: the base lost the stop 35 s after a recorder's link
+    was cut, while ~heartbeat went on). A write that cannot go on for SEND_TIMEOUT now fails, and
+    rospy drops that connection (reconnect.py tells its node, once it answers, to connect again).
+    A queued publisher (a rospy thread per subscriber) isolates as well, but its hand-off doubled
+    the `limit` action's added latency (bench/README.md)."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # rospy warns that queue_size is not set: on purpose
+        pub = rospy.Publisher(topic, cls, queue_size=None, tcp_nodelay=True)
+    _bound_writes(pub.impl)
+    return pub
 
 
-def flush(pub: rospy.Publisher, timeout: float = 0.5) -> None:
-    """Wait (at most `timeout`) until each subscriber's thread has taken what was handed to it: an
-    `on_release` published as the monitor stops reaches the subscribers that read before the
-    publisher closes their connections (one that does not read is not waited for longer)."""
-    end = time.monotonic() + timeout
-    for conn in list(getattr(pub.impl, "connections", None) or []):
-        while getattr(conn, "_queue", None) and time.monotonic() < end:  # rospy's QueuedConnection
-            time.sleep(0.005)
+def _bound_writes(impl: Any) -> None:
+    """Give each subscriber connection of this topic (rospy's _PublisherImpl, shared by the process's
+    publishers of it) a send timeout as it is added."""
+    if impl is None or getattr(impl, "_rubass_bounded", False):
+        return
+    add = impl.add_connection
+
+    def add_connection(conn: Any) -> Any:
+        sock = getattr(conn, "socket", None)
+        if sock is not None:
+            sock.settimeout(SEND_TIMEOUT)  # sendall raises after it: rospy's publish drops the connection
+        return add(conn)
+    impl.add_connection = add_connection
+    impl._rubass_bounded = True
 
 
 class PublishPlugin(ActionPlugin):
@@ -171,6 +185,5 @@ class PublishPlugin(ActionPlugin):
         if self.seat is not None:
             self.seat.leave()
         if self.pub is not None:
-            flush(self.pub)
             self.pub.unregister()
             self.pub = None
