@@ -87,7 +87,7 @@ class LostConnections:
         for topic, impl in subs:
             live = _live(impl, by_header=True)
             for node in self._lost_nodes("sub", topic, live, publishers.get(topic, []), lost):
-                done += self._ask_rospy(topic, node, publishers.get(topic, []), live, lost, now, update)
+                done += self._ask_rospy(topic, node, publishers.get(topic, []), lost, update)
         probed: Dict[str, bool] = {}
         for topic, type_name, impl in pubs:
             live = _live(impl, by_header=False)
@@ -117,8 +117,7 @@ class LostConnections:
                     out.append(node)
         return out
 
-    def _ask_rospy(self, topic: str, node: str, listed: List[str], live: Set[str],
-                   lost: Dict[Tuple[str, str, str], _Episode], now: float,
+    def _ask_rospy(self, topic: str, node: str, listed: List[str], lost: Dict[Tuple[str, str, str], _Episode],
                    update: Callable[[str, List[str]], None]) -> int:
         """Once an episode: the topic's listed publishers' URIs to rospy, which connects to those it has
         no connection to (and retries on its own thread until it can, as at subscription)."""
